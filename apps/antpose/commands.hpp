@@ -1,0 +1,19 @@
+// The CLI is a thin layer: each verb parses its options and calls the library.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include "antpose/core/error.hpp"
+
+namespace antpose::cli {
+
+void add_convert_command(CLI::App& app);
+void add_inspect_command(CLI::App& app);
+void add_wmm_command(CLI::App& app);
+void add_contact_command(CLI::App& app);
+void add_simulate_command(CLI::App& app);
+
+/// Prints each warning as "warning: <file>:<line>: <message>" on stderr.
+void print_warnings(const Diagnostics& diagnostics);
+
+}  // namespace antpose::cli

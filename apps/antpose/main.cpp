@@ -1,0 +1,42 @@
+// antpose <verb> ...: entry point. Errors end the program with a message and a non-zero status:
+// 2 for bad input, 3 for a measurement that the data cannot support, 1 for anything else.
+#include <cstdio>
+#include <exception>
+
+#include <fmt/core.h>
+
+#include "commands.hpp"
+
+namespace antpose::cli {
+
+void print_warnings(const Diagnostics& diagnostics) {
+  for (const auto& w : diagnostics.warnings()) fmt::print(stderr, "warning: {}\n", w.to_string());
+}
+
+}  // namespace antpose::cli
+
+int main(int argc, char** argv) {
+  CLI::App app{"antpose: antenna azimuth, downtilt and roll from a smartphone"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "antpose 0.1.0");
+  antpose::cli::add_convert_command(app);
+  antpose::cli::add_inspect_command(app);
+  antpose::cli::add_wmm_command(app);
+  antpose::cli::add_contact_command(app);
+  antpose::cli::add_simulate_command(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  } catch (const antpose::InputError& e) {
+    fmt::print(stderr, "error: {}\n", e.what());
+    return 2;
+  } catch (const antpose::MeasurementError& e) {
+    fmt::print(stderr, "error: {}\n", e.what());
+    return 3;
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "error: {}\n", e.what());
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,404 @@
+#include "antpose/io/capture.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <set>
+
+#include <fmt/format.h>
+
+#include "antpose/io/csv.hpp"
+#include "antpose/io/text_file.hpp"
+#include "antpose/io/units.hpp"
+
+namespace antpose {
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr const char* kFormatName = "antpose-capture";
+const std::set<std::string> kKinds = {"imu-log", "contact", "imu-calibration", "camera-calibration",
+                                      "joint-calibration", "antenna"};
+const std::set<std::string> kSensorFrames = {"android", "other"};
+const std::set<std::string> kTruthWorlds = {"enu-true", "enu-magnetic", "unaligned"};
+
+std::string stream_stem(const fs::path& file) {
+  std::string name = file.filename().string();
+  for (const char* suffix : {".csv.gz", ".csv"})
+    if (name.ends_with(suffix)) return name.substr(0, name.size() - std::string_view(suffix).size());
+  return {};
+}
+
+// --- capture.yaml -------------------------------------------------------------------------
+
+std::size_t yaml_line(const YAML::Node& node) { return node.Mark().is_null() ? 0 : static_cast<std::size_t>(node.Mark().line) + 1; }
+
+template <typename T>
+T yaml_as(const YAML::Node& node, const fs::path& file, std::string_view key, std::string_view expected) {
+  try {
+    return node.as<T>();
+  } catch (const YAML::Exception&) {
+    throw InputError(file, yaml_line(node),
+                     fmt::format("'{}' is '{}', expected {}", key, node.IsScalar() ? node.Scalar() : "(not a scalar)", expected));
+  }
+}
+
+std::string yaml_choice(const YAML::Node& node, const fs::path& file, std::string_view key, const std::set<std::string>& allowed) {
+  const auto value = yaml_as<std::string>(node, file, key, "a name");
+  if (!allowed.contains(value))
+    throw InputError(file, yaml_line(node), fmt::format("{} '{}' is unknown; expected one of {}", key, value, fmt::join(allowed, ", ")));
+  return value;
+}
+
+bool is_iso_date(std::string_view s) {
+  if (s.size() != 10 || s[4] != '-' || s[7] != '-') return false;
+  for (std::size_t i : {0, 1, 2, 3, 5, 6, 8, 9})
+    if (s[i] < '0' || s[i] > '9') return false;
+  const int month = (s[5] - '0') * 10 + (s[6] - '0');
+  const int day = (s[8] - '0') * 10 + (s[9] - '0');
+  return month >= 1 && month <= 12 && day >= 1 && day <= 31;
+}
+
+Site parse_site(const YAML::Node& node, const fs::path& file) {
+  if (!node.IsMap()) throw InputError(file, yaml_line(node), "'site' must be a map with lat_deg, lon_deg, alt_m, date");
+  Site site;
+  auto number = [&](const char* key, double lo, double hi, bool required, double fallback) {
+    if (!node[key]) {
+      if (required) throw InputError(file, yaml_line(node), fmt::format("site: '{}' is missing", key));
+      return fallback;
+    }
+    const double v = yaml_as<double>(node[key], file, fmt::format("site.{}", key), "a number");
+    if (!std::isfinite(v) || v < lo || v > hi)
+      throw InputError(file, yaml_line(node[key]), fmt::format("site.{} = {} is out of range, expected [{}, {}]", key, v, lo, hi));
+    return v;
+  };
+  site.lat_deg = number("lat_deg", -90.0, 90.0, true, 0.0);
+  site.lon_deg = number("lon_deg", -180.0, 360.0, true, 0.0);
+  site.alt_m = number("alt_m", -1000.0, 100000.0, false, 0.0);
+  if (site.lon_deg > 180.0) site.lon_deg -= 360.0;
+  if (node["date"]) {
+    site.date = yaml_as<std::string>(node["date"], file, "site.date", "a date YYYY-MM-DD");
+    if (!is_iso_date(site.date))
+      throw InputError(file, yaml_line(node["date"]), fmt::format("site.date '{}' is not a date, expected YYYY-MM-DD", site.date));
+  }
+  return site;
+}
+
+void parse_metadata(Capture& c, const fs::path& file) {
+  try {
+    c.metadata = YAML::Load(io::read_text(file));
+  } catch (const YAML::Exception& e) {
+    throw InputError(file, e.mark.is_null() ? 0 : static_cast<std::size_t>(e.mark.line) + 1, "not valid YAML: " + e.msg);
+  }
+  const YAML::Node& m = c.metadata;
+  if (!m.IsMap()) throw InputError(file, "expected a YAML map with 'format: antpose-capture'");
+  if (!m["format"]) throw InputError(file, "no 'format' key: not an antpose capture (expected 'format: antpose-capture')");
+  const auto format = yaml_as<std::string>(m["format"], file, "format", kFormatName);
+  if (format != kFormatName)
+    throw InputError(file, yaml_line(m["format"]), fmt::format("unknown format '{}', expected '{}'", format, kFormatName));
+  if (!m["version"]) throw InputError(file, "no 'version' key (expected 'version: 1')");
+  const int version = yaml_as<int>(m["version"], file, "version", "an integer");
+  if (version < 1 || version > Capture::kFormatVersion)
+    throw InputError(file, yaml_line(m["version"]),
+                     fmt::format("format version {} is not supported; this antpose reads versions 1 to {}", version,
+                                 Capture::kFormatVersion));
+  if (m["kind"]) c.kind = yaml_choice(m["kind"], file, "kind", kKinds);
+  if (m["time_origin"]) c.time_origin = yaml_as<std::string>(m["time_origin"], file, "time_origin", "an ISO-8601 UTC instant");
+  if (const auto d = m["device"]; d && d.IsMap()) {
+    if (d["model"]) c.device_model = yaml_as<std::string>(d["model"], file, "device.model", "text");
+    if (d["id"]) c.device_id = yaml_as<std::string>(d["id"], file, "device.id", "text");
+  }
+  if (m["sensor_frame"]) c.sensor_frame = yaml_choice(m["sensor_frame"], file, "sensor_frame", kSensorFrames);
+  if (m["site"] && !m["site"].IsNull()) c.site = parse_site(m["site"], file);
+  if (const auto truth = m["truth"]; truth && truth.IsMap() && truth["world"])
+    c.truth_world = yaml_choice(truth["world"], file, "truth.world", kTruthWorlds);
+}
+
+// --- tables -------------------------------------------------------------------------------
+
+Stream parse_stream(const io::CsvText& csv, std::string name, io::NonFinite non_finite) {
+  const std::size_t t_col = csv.column("t");
+  Stream s;
+  s.name = std::move(name);
+  s.gzip = io::is_gzip_name(csv.file);
+  std::vector<std::size_t> value_cols;
+  for (std::size_t j = 0; j < csv.header.size(); ++j)
+    if (j != t_col) {
+      s.columns.push_back(csv.header[j]);
+      value_cols.push_back(j);
+    }
+  s.t.resize(csv.rows.size());
+  s.values.resize(static_cast<Eigen::Index>(csv.rows.size()), static_cast<Eigen::Index>(value_cols.size()));
+  for (std::size_t i = 0; i < csv.rows.size(); ++i) {
+    const auto& row = csv.rows[i];
+    s.t[i] = io::parse_number(row[t_col], csv.file, csv.lines[i], "t");
+    for (std::size_t k = 0; k < value_cols.size(); ++k)
+      s.values(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(k)) =
+          io::parse_number(row[value_cols[k]], csv.file, csv.lines[i], csv.header[value_cols[k]], non_finite);
+  }
+  return s;
+}
+
+std::string stream_csv(const Stream& s) {
+  std::string out = "t";
+  for (const auto& c : s.columns) out += "," + c;
+  out += '\n';
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    out += io::format_number(s.t[i]);
+    for (Eigen::Index k = 0; k < s.values.cols(); ++k) {
+      out += ',';
+      out += io::format_number(s.values(static_cast<Eigen::Index>(i), k));
+    }
+    out += '\n';
+  }
+  return out;
+}
+
+void read_shots(Capture& c, const fs::path& folder) {
+  const fs::path file = folder / "shots.csv";
+  const auto csv = io::read_csv(file);
+  const std::size_t ci = csv.column("index"), ct = csv.column("t"), cimg = csv.column("image");
+  const auto cexp = csv.find_column("exposure_s");
+  std::vector<std::size_t> extra;
+  for (std::size_t j = 0; j < csv.header.size(); ++j)
+    if (j != ci && j != ct && j != cimg && static_cast<std::ptrdiff_t>(j) != cexp) {
+      extra.push_back(j);
+      c.shot_extra_columns.push_back(csv.header[j]);
+    }
+  for (std::size_t i = 0; i < csv.rows.size(); ++i) {
+    const auto& row = csv.rows[i];
+    const std::size_t line = csv.lines[i];
+    Shot shot;
+    const double index = io::parse_number(row[ci], file, line, "index");
+    if (index != std::floor(index) || index < 0)
+      throw InputError(file, line, fmt::format("column 'index': '{}' is not a non-negative integer", row[ci]));
+    shot.index = static_cast<int>(index);
+    shot.t = io::parse_number(row[ct], file, line, "t");
+    shot.image = row[cimg];
+    if (shot.image.empty()) throw InputError(file, line, "column 'image' is empty, expected a path relative to the capture");
+    if (!fs::is_regular_file(folder / shot.image))
+      throw InputError(file, line, fmt::format("image '{}' not found in {}", shot.image, folder.string()));
+    if (cexp >= 0 && !row[static_cast<std::size_t>(cexp)].empty())
+      shot.exposure_s = io::parse_number(row[static_cast<std::size_t>(cexp)], file, line, "exposure_s");
+    for (std::size_t j : extra) shot.extra.push_back(row[j]);
+    c.shots.push_back(std::move(shot));
+  }
+}
+
+std::string shots_csv(const Capture& c) {
+  const bool with_exposure = std::any_of(c.shots.begin(), c.shots.end(), [](const Shot& s) { return s.exposure_s.has_value(); });
+  std::vector<std::string> header = {"index", "t", "image"};
+  if (with_exposure) header.push_back("exposure_s");
+  header.insert(header.end(), c.shot_extra_columns.begin(), c.shot_extra_columns.end());
+  std::string out = io::join_csv_line(header) + '\n';
+  for (const auto& s : c.shots) {
+    std::vector<std::string> row = {std::to_string(s.index), io::format_number(s.t), s.image};
+    if (with_exposure) row.push_back(s.exposure_s ? io::format_number(*s.exposure_s) : "");
+    row.insert(row.end(), s.extra.begin(), s.extra.end());
+    out += io::join_csv_line(row) + '\n';
+  }
+  return out;
+}
+
+YAML::Node metadata_yaml(const Capture& c) {
+  YAML::Node out;
+  out["format"] = kFormatName;
+  out["version"] = Capture::kFormatVersion;
+  out["kind"] = c.kind;
+  if (c.time_origin) out["time_origin"] = *c.time_origin;
+  YAML::Node device = c.metadata["device"] && c.metadata["device"].IsMap() ? YAML::Clone(c.metadata["device"]) : YAML::Node();
+  if (!c.device_model.empty()) device["model"] = c.device_model;
+  if (!c.device_id.empty()) device["id"] = c.device_id;
+  if (device.size() > 0) out["device"] = device;
+  out["sensor_frame"] = c.sensor_frame;
+  if (c.site) {
+    YAML::Node site;
+    site["lat_deg"] = io::format_number(c.site->lat_deg);
+    site["lon_deg"] = io::format_number(c.site->lon_deg);
+    site["alt_m"] = io::format_number(c.site->alt_m);
+    if (!c.site->date.empty()) site["date"] = c.site->date;
+    out["site"] = site;
+  }
+  if (c.truth_orientation || !c.truth_world.empty()) {
+    YAML::Node truth = c.metadata["truth"] && c.metadata["truth"].IsMap() ? YAML::Clone(c.metadata["truth"]) : YAML::Node();
+    if (c.truth_orientation)
+      truth["orientation"] = c.truth_orientation->gzip ? "truth/orientation.csv.gz" : "truth/orientation.csv";
+    if (!c.truth_world.empty()) truth["world"] = c.truth_world;
+    out["truth"] = truth;
+  }
+  if (c.metadata.IsMap())
+    for (const auto& kv : c.metadata) {
+      const auto key = kv.first.as<std::string>();
+      if (!out[key]) out[key] = YAML::Clone(kv.second);
+    }
+  return out;
+}
+
+fs::path truth_orientation_file(const fs::path& folder, const YAML::Node& truth) {
+  if (truth && truth.IsMap() && truth["orientation"]) return folder / truth["orientation"].as<std::string>();
+  for (const char* name : {"truth/orientation.csv.gz", "truth/orientation.csv"})
+    if (fs::exists(folder / name)) return folder / name;
+  return {};
+}
+
+}  // namespace
+
+bool Stream::has_xyz() const { return columns.size() >= 3 && columns[0] == "x" && columns[1] == "y" && columns[2] == "z"; }
+
+Stream Stream::vector3(std::string name, std::vector<double> t, const std::vector<Vec3>& xyz) {
+  Stream s;
+  s.name = std::move(name);
+  s.columns = {"x", "y", "z"};
+  s.values.resize(static_cast<Eigen::Index>(xyz.size()), 3);
+  for (std::size_t i = 0; i < xyz.size(); ++i) s.values.row(static_cast<Eigen::Index>(i)) = xyz[i].transpose();
+  s.t = std::move(t);
+  return s;
+}
+
+const Stream* Capture::find(std::string_view name) const {
+  const auto it = streams.find(std::string(name));
+  return it == streams.end() ? nullptr : &it->second;
+}
+
+const Stream& Capture::require(std::string_view name) const {
+  if (const Stream* s = find(name)) return *s;
+  std::vector<std::string> have;
+  for (const auto& [k, v] : streams) have.push_back(k);
+  throw InputError(root / "sensors", fmt::format("no {} stream (sensors/{}.csv); the capture has: {}", name, name,
+                                                 have.empty() ? std::string("no streams") : fmt::format("{}", fmt::join(have, ", "))));
+}
+
+fs::path stream_path(const fs::path& folder, const Stream& stream) {
+  return folder / "sensors" / (stream.name + (stream.gzip ? ".csv.gz" : ".csv"));
+}
+
+Capture read_capture(const fs::path& folder, Diagnostics& diagnostics, const CaptureReadOptions& options) {
+  if (!fs::exists(folder)) throw InputError(folder, "capture folder not found");
+  if (!fs::is_directory(folder)) throw InputError(folder, "is a file, expected a capture folder (with capture.yaml)");
+  const fs::path yaml = folder / "capture.yaml";
+  if (!fs::exists(yaml)) throw InputError(yaml, "missing: not an antpose capture folder (use 'antpose convert' to import phone-logger exports)");
+  Capture c;
+  c.root = folder;
+  parse_metadata(c, yaml);
+
+  std::set<fs::path> known = {"capture.yaml", "shots.csv"};
+  if (fs::is_directory(folder / "sensors")) {
+    std::vector<fs::path> files;
+    for (const auto& e : fs::directory_iterator(folder / "sensors"))
+      if (e.is_regular_file() && !stream_stem(e.path()).empty()) files.push_back(e.path());
+    std::sort(files.begin(), files.end());
+    for (const auto& f : files) {
+      std::string name = stream_stem(f);
+      if (c.streams.contains(name))
+        throw InputError(f, fmt::format("stream '{}' is stored twice (both .csv and .csv.gz); keep one", name));
+      c.streams.emplace(name, parse_stream(io::read_csv(f), name, io::NonFinite::kReject));
+      known.insert(fs::relative(f, folder));
+    }
+  }
+  if (fs::exists(folder / "shots.csv")) read_shots(c, folder);
+  for (const auto& s : c.shots) known.insert(fs::path(s.image).lexically_normal());
+
+  if (const fs::path truth = truth_orientation_file(folder, c.metadata["truth"]); !truth.empty()) {
+    auto table = parse_stream(io::read_csv(truth), "truth/orientation", io::NonFinite::kAllow);
+    for (const char* col : {"qw", "qx", "qy", "qz"})
+      if (std::find(table.columns.begin(), table.columns.end(), col) == table.columns.end())
+        throw InputError(truth, 1, fmt::format("missing column '{}' (expected t,qw,qx,qy,qz[,valid,moving])", col));
+    c.truth_orientation = std::move(table);
+    known.insert(fs::relative(truth, folder));
+  }
+  for (const auto& e : fs::recursive_directory_iterator(folder)) {
+    if (!e.is_regular_file()) continue;
+    const fs::path rel = fs::relative(e.path(), folder);
+    if (!known.contains(rel) && !rel.filename().string().starts_with(".")) c.other_files.push_back(rel);
+  }
+  std::sort(c.other_files.begin(), c.other_files.end());
+  validate_capture(c, folder, diagnostics, options);
+  return c;
+}
+
+void validate_capture(Capture& c, const fs::path& folder, Diagnostics& diagnostics, const CaptureReadOptions& options) {
+  double span_lo = INFINITY, span_hi = -INFINITY;
+  for (auto& [name, s] : c.streams) {
+    const fs::path file = stream_path(folder, s);
+    if (s.empty()) throw InputError(file, "no samples: the stream is empty (only a header)");
+    for (std::size_t i = 1; i < s.size(); ++i) {
+      if (s.t[i] < s.t[i - 1])
+        throw InputError(file, i + 2, fmt::format("t = {} goes backwards (previous row has t = {}); rows must be in increasing time",
+                                                  io::format_number(s.t[i]), io::format_number(s.t[i - 1])));
+      if (s.t[i] == s.t[i - 1])
+        throw InputError(file, i + 2, fmt::format("t = {} repeats the previous row's time; rows must be in increasing time",
+                                                  io::format_number(s.t[i])));
+    }
+    if (s.size() >= 3) {
+      std::vector<double> dt(s.size() - 1);
+      for (std::size_t i = 1; i < s.size(); ++i) dt[i - 1] = s.t[i] - s.t[i - 1];
+      std::vector<double> sorted = dt;
+      std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+      const double median = sorted[sorted.size() / 2];
+      std::size_t reported = 0;
+      for (std::size_t i = 0; i < dt.size(); ++i)
+        if (dt[i] > options.gap_factor * median && dt[i] > 0.05) {
+          if (++reported <= 3)
+            diagnostics.warn(file, i + 3, fmt::format("gap of {:.3f} s in the stream (median interval {:.4f} s)", dt[i], median));
+        }
+      if (reported > 3) diagnostics.warn(file, 0, fmt::format("{} gaps in all (only the first 3 are listed)", reported));
+    }
+    span_lo = std::min(span_lo, s.t.front());
+    span_hi = std::max(span_hi, s.t.back());
+  }
+  io::check_units(c, folder, diagnostics, options.repair_units);
+  for (std::size_t i = 0; i < c.shots.size(); ++i) {
+    const auto& shot = c.shots[i];
+    if (!c.streams.empty() && (shot.t < span_lo || shot.t > span_hi))
+      diagnostics.warn(folder / "shots.csv", i + 2,
+                       fmt::format("shot {} at t = {} s lies outside the sensor data ({:.3f} … {:.3f} s): no orientation for it",
+                                   shot.index, io::format_number(shot.t), span_lo, span_hi));
+  }
+}
+
+void write_capture(const Capture& c, const fs::path& folder, const CaptureWriteOptions& options) {
+  if (fs::exists(folder) && !options.overwrite)
+    throw InputError(folder, "already exists; choose a new output folder (antpose never overwrites data)");
+  const fs::path parent = folder.parent_path().empty() ? fs::path(".") : folder.parent_path();
+  fs::create_directories(parent);
+  std::random_device rd;
+  const fs::path tmp = parent / fmt::format(".{}.tmp-{:08x}", folder.filename().string(), rd());
+  try {
+    fs::create_directories(tmp);
+    YAML::Emitter yaml;
+    yaml << metadata_yaml(c);
+    io::write_text_atomic(tmp / "capture.yaml", std::string(yaml.c_str()) + "\n");
+    for (const auto& [name, s] : c.streams) io::write_text_atomic(stream_path(tmp, s), stream_csv(s));
+    if (!c.shots.empty()) {
+      io::write_text_atomic(tmp / "shots.csv", shots_csv(c));
+      for (const auto& s : c.shots) {
+        const fs::path from = s.source.empty() ? c.root / s.image : s.source;
+        fs::create_directories((tmp / s.image).parent_path());
+        fs::copy_file(from, tmp / s.image, fs::copy_options::overwrite_existing);
+      }
+    }
+    if (c.truth_orientation) {
+      Stream truth = *c.truth_orientation;
+      truth.name = "orientation";
+      io::write_text_atomic(tmp / "truth" / (truth.gzip ? "orientation.csv.gz" : "orientation.csv"), stream_csv(truth));
+    }
+    for (const auto& rel : c.other_files) {
+      fs::create_directories((tmp / rel).parent_path());
+      fs::copy_file(c.root / rel, tmp / rel, fs::copy_options::overwrite_existing);
+    }
+    if (fs::exists(folder)) {
+      const fs::path old = parent / fmt::format(".{}.old-{:08x}", folder.filename().string(), rd());
+      fs::rename(folder, old);
+      fs::rename(tmp, folder);
+      fs::remove_all(old);
+    } else {
+      fs::rename(tmp, folder);
+    }
+  } catch (...) {
+    std::error_code ignored;
+    fs::remove_all(tmp, ignored);
+    throw;
+  }
+}
+
+}  // namespace antpose

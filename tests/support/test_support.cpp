@@ -1,0 +1,63 @@
+#include "support/test_support.hpp"
+
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <stdexcept>
+
+namespace antpose::test {
+namespace fs = std::filesystem;
+
+fs::path shared_path(std::string_view relative) {
+  const fs::path root = ANTPOSE_SHARED_DIR;
+  if (!fs::is_directory(root))
+    throw std::runtime_error("shared reference folder not found: " + root.string() +
+                             " (set the CMake cache variable ANTPOSE_SHARED_DIR to the folder holding notes/ and data/)");
+  const fs::path p = root / relative;
+  if (!fs::exists(p))
+    throw std::runtime_error("shared reference data missing: " + p.string() + " (ANTPOSE_SHARED_DIR=" + root.string() + ")");
+  return p;
+}
+
+fs::path source_path(std::string_view relative) { return fs::path(ANTPOSE_SOURCE_DIR) / relative; }
+
+TempDir::TempDir() {
+  std::random_device rd;
+  path_ = fs::temp_directory_path() / ("antpose-test-" + std::to_string(rd()) + std::to_string(rd()));
+  fs::create_directories(path_);
+}
+
+TempDir::~TempDir() {
+  std::error_code ignored;
+  fs::remove_all(path_, ignored);
+}
+
+void write_file(const fs::path& file, std::string_view content) {
+  if (!file.parent_path().empty()) fs::create_directories(file.parent_path());
+  std::ofstream out(file, std::ios::binary);
+  out.write(content.data(), static_cast<std::streamsize>(content.size()));
+  if (!out) throw std::runtime_error("cannot write test file " + file.string());
+}
+
+CliResult run_cli(const std::string& args) {
+  TempDir dir;
+  const std::string cmd = std::string("'") + ANTPOSE_CLI_PATH + "' " + args + " >'" + (dir / "out").string() + "' 2>'" +
+                          (dir / "err").string() + "'";
+  const int raw = std::system(cmd.c_str());
+  CliResult r;
+  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+  auto slurp = [](const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+  };
+  r.out = slurp(dir / "out");
+  r.err = slurp(dir / "err");
+  return r;
+}
+
+}  // namespace antpose::test

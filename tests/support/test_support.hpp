@@ -1,0 +1,44 @@
+// Helpers shared by the tests: reference data, scratch folders and running the CLI.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <string_view>
+
+namespace antpose::test {
+
+/// Path of `relative` inside ANTPOSE_SHARED_DIR (a CMake cache variable, default ../shared).
+/// Throws with a clear message when the shared folder or the file is missing, which fails the
+/// test that needed it.
+std::filesystem::path shared_path(std::string_view relative);
+
+/// Path inside the source tree (examples/, data/).
+std::filesystem::path source_path(std::string_view relative);
+
+/// A fresh empty folder, removed with its contents when the object dies.
+class TempDir {
+ public:
+  TempDir();
+  ~TempDir();
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  const std::filesystem::path& path() const { return path_; }
+  std::filesystem::path operator/(std::string_view name) const { return path_ / name; }
+
+ private:
+  std::filesystem::path path_;
+};
+
+/// Writes a text file (creating folders).
+void write_file(const std::filesystem::path& file, std::string_view content);
+
+struct CliResult {
+  int status = 0;
+  std::string out;  // stdout
+  std::string err;  // stderr
+};
+
+/// Runs the antpose executable with the given argument string (shell syntax).
+CliResult run_cli(const std::string& args);
+
+}  // namespace antpose::test
