@@ -1,11 +1,46 @@
+// antpose inspect CAPTURE: what a capture holds (streams, rates, gaps, statistics, shots, truth).
+#include <memory>
+#include <string>
+
+#include <fmt/format.h>
+
+#include "antpose/io/import.hpp"
+#include "antpose/io/inspect.hpp"
+#include "antpose/io/text_file.hpp"
 #include "commands.hpp"
 
 namespace antpose::cli {
 
-// Placeholder until the inspect verb lands.
+namespace {
+
+struct InspectOptions {
+  std::string capture;
+  std::string json;
+  bool no_unit_repair = false;
+};
+
+void run_inspect(const InspectOptions& o) {
+  Diagnostics diagnostics;
+  CaptureReadOptions read_options;
+  read_options.repair_units = !o.no_unit_repair;
+  const CaptureFormat format = detect_capture_format(o.capture);
+  const Capture capture = import_capture(o.capture, diagnostics, read_options);
+  CaptureSummary summary = summarize(capture, read_options.gap_factor);
+  summary.format = std::string(to_string(format));
+  print_warnings(diagnostics);
+  fmt::print("{}", format_summary(summary));
+  if (!o.json.empty()) io::write_text_atomic(o.json, to_json(summary).dump(2) + "\n");
+}
+
+}  // namespace
+
 void add_inspect_command(CLI::App& app) {
-  auto* cmd = app.add_subcommand("inspect", "(not yet available)");
-  cmd->callback([] { throw Error("'inspect' is not available in this build yet"); });
+  auto opts = std::make_shared<InspectOptions>();
+  auto* cmd = app.add_subcommand("inspect", "Summarize a capture: streams, rates, jitter, gaps, statistics, shots, truth");
+  cmd->add_option("CAPTURE", opts->capture, "Capture folder or export (any layout convert reads)")->required();
+  cmd->add_option("--json", opts->json, "Also write the summary as JSON to this file");
+  cmd->add_flag("--no-unit-repair", opts->no_unit_repair, "Refuse streams in the wrong unit instead of converting them");
+  cmd->callback([opts] { run_inspect(*opts); });
 }
 
 }  // namespace antpose::cli

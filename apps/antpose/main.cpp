@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
   antpose::cli::add_wmm_command(app);
   antpose::cli::add_contact_command(app);
   antpose::cli::add_simulate_command(app);
+  antpose::cli::add_bench_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -9,6 +9,7 @@
 
 #include "antpose/io/csv.hpp"
 #include "antpose/io/text_file.hpp"
+#include "antpose/io/time.hpp"
 #include "antpose/io/units.hpp"
 
 namespace antpose {
@@ -103,7 +104,13 @@ void parse_metadata(Capture& c, const fs::path& file) {
                      fmt::format("format version {} is not supported; this antpose reads versions 1 to {}", version,
                                  Capture::kFormatVersion));
   if (m["kind"]) c.kind = yaml_choice(m["kind"], file, "kind", kKinds);
-  if (m["time_origin"]) c.time_origin = yaml_as<std::string>(m["time_origin"], file, "time_origin", "an ISO-8601 UTC instant");
+  if (m["time_origin"] && !m["time_origin"].IsNull()) {
+    c.time_origin = yaml_as<std::string>(m["time_origin"], file, "time_origin", "an ISO-8601 UTC instant");
+    if (!io::parse_utc_iso8601(*c.time_origin))
+      throw InputError(file, yaml_line(m["time_origin"]),
+                       fmt::format("time_origin '{}' is not an ISO-8601 UTC instant, expected e.g. 2014-01-04T11:34:44.114Z",
+                                   *c.time_origin));
+  }
   if (const auto d = m["device"]; d && d.IsMap()) {
     if (d["model"]) c.device_model = yaml_as<std::string>(d["model"], file, "device.model", "text");
     if (d["id"]) c.device_id = yaml_as<std::string>(d["id"], file, "device.id", "text");
@@ -121,6 +128,8 @@ Stream parse_stream(const io::CsvText& csv, std::string name, io::NonFinite non_
   Stream s;
   s.name = std::move(name);
   s.gzip = io::is_gzip_name(csv.file);
+  s.source_file = csv.file;
+  s.source_lines = csv.lines;
   std::vector<std::size_t> value_cols;
   for (std::size_t j = 0; j < csv.header.size(); ++j)
     if (j != t_col) {
@@ -157,6 +166,7 @@ std::string stream_csv(const Stream& s) {
 void read_shots(Capture& c, const fs::path& folder) {
   const fs::path file = folder / "shots.csv";
   const auto csv = io::read_csv(file);
+  c.shots_file = file;
   const std::size_t ci = csv.column("index"), ct = csv.column("t"), cimg = csv.column("image");
   const auto cexp = csv.find_column("exposure_s");
   std::vector<std::size_t> extra;
@@ -173,6 +183,7 @@ void read_shots(Capture& c, const fs::path& folder) {
     if (index != std::floor(index) || index < 0)
       throw InputError(file, line, fmt::format("column 'index': '{}' is not a non-negative integer", row[ci]));
     shot.index = static_cast<int>(index);
+    shot.source_line = line;
     shot.t = io::parse_number(row[ct], file, line, "t");
     shot.image = row[cimg];
     if (shot.image.empty()) throw InputError(file, line, "column 'image' is empty, expected a path relative to the capture");
@@ -223,13 +234,19 @@ YAML::Node metadata_yaml(const Capture& c) {
     YAML::Node truth = c.metadata["truth"] && c.metadata["truth"].IsMap() ? YAML::Clone(c.metadata["truth"]) : YAML::Node();
     if (c.truth_orientation)
       truth["orientation"] = c.truth_orientation->gzip ? "truth/orientation.csv.gz" : "truth/orientation.csv";
+    else if (truth["orientation"])
+      truth.remove("orientation");
     if (!c.truth_world.empty()) truth["world"] = c.truth_world;
     out["truth"] = truth;
   }
+  // Keys the writer derives from the Capture fields are not copied from the old metadata: a
+  // field cleared in memory (time_origin, site, truth) must not come back from it.
+  static const std::set<std::string> kManaged = {"format", "version", "kind", "time_origin", "device",
+                                                 "sensor_frame", "site", "truth"};
   if (c.metadata.IsMap())
     for (const auto& kv : c.metadata) {
       const auto key = kv.first.as<std::string>();
-      if (!out[key]) out[key] = YAML::Clone(kv.second);
+      if (!kManaged.contains(key) && !out[key]) out[key] = YAML::Clone(kv.second);
     }
   return out;
 }
@@ -272,6 +289,15 @@ fs::path stream_path(const fs::path& folder, const Stream& stream) {
   return folder / "sensors" / (stream.name + (stream.gzip ? ".csv.gz" : ".csv"));
 }
 
+fs::path stream_source(const fs::path& folder, const Stream& stream) {
+  return stream.source_file.empty() ? stream_path(folder, stream) : stream.source_file;
+}
+
+std::size_t Stream::source_line(std::size_t i) const {
+  if (source_lines.size() == t.size() && i < source_lines.size()) return source_lines[i];
+  return source_file.empty() ? i + 2 : 0;
+}
+
 Capture read_capture(const fs::path& folder, Diagnostics& diagnostics, const CaptureReadOptions& options) {
   if (!fs::exists(folder)) throw InputError(folder, "capture folder not found");
   if (!fs::is_directory(folder)) throw InputError(folder, "is a file, expected a capture folder (with capture.yaml)");
@@ -309,7 +335,8 @@ Capture read_capture(const fs::path& folder, Diagnostics& diagnostics, const Cap
   for (const auto& e : fs::recursive_directory_iterator(folder)) {
     if (!e.is_regular_file()) continue;
     const fs::path rel = fs::relative(e.path(), folder);
-    if (!known.contains(rel) && !rel.filename().string().starts_with(".")) c.other_files.push_back(rel);
+    const bool hidden = std::any_of(rel.begin(), rel.end(), [](const fs::path& part) { return part.string().starts_with("."); });
+    if (!known.contains(rel) && !hidden) c.other_files.push_back(rel);
   }
   std::sort(c.other_files.begin(), c.other_files.end());
   validate_capture(c, folder, diagnostics, options);
@@ -319,27 +346,43 @@ Capture read_capture(const fs::path& folder, Diagnostics& diagnostics, const Cap
 void validate_capture(Capture& c, const fs::path& folder, Diagnostics& diagnostics, const CaptureReadOptions& options) {
   double span_lo = INFINITY, span_hi = -INFINITY;
   for (auto& [name, s] : c.streams) {
-    const fs::path file = stream_path(folder, s);
-    if (s.empty()) throw InputError(file, "no samples: the stream is empty (only a header)");
-    for (std::size_t i = 1; i < s.size(); ++i) {
+    const fs::path file = stream_source(folder, s);
+    if (s.empty()) throw InputError(file, fmt::format("no samples: the {} stream is empty (only a header)", name));
+    if (static_cast<std::size_t>(s.values.rows()) != s.size() || static_cast<std::size_t>(s.values.cols()) != s.columns.size())
+      throw Error(fmt::format("{}: stream '{}' has {} times but a {}×{} value table for {} columns (a bug in the code that built it)",
+                              file.string(), name, s.size(), s.values.rows(), s.values.cols(), s.columns.size()));
+    for (std::size_t i = 0; i < s.size(); ++i) {
+      if (!std::isfinite(s.t[i]))
+        throw InputError(file, s.source_line(i), fmt::format("t = {} is not a finite time", io::format_number(s.t[i])));
+      for (std::size_t k = 0; k < s.columns.size(); ++k) {
+        const double v = s.values(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(k));
+        if (!std::isfinite(v))
+          throw InputError(file, s.source_line(i),
+                           fmt::format("column '{}': {} is not a finite number (NaN/Inf not allowed in a sensor stream)",
+                                       s.columns[k], io::format_number(v)));
+      }
+      if (i == 0) continue;
       if (s.t[i] < s.t[i - 1])
-        throw InputError(file, i + 2, fmt::format("t = {} goes backwards (previous row has t = {}); rows must be in increasing time",
-                                                  io::format_number(s.t[i]), io::format_number(s.t[i - 1])));
+        throw InputError(file, s.source_line(i),
+                         fmt::format("t = {} goes backwards (previous row has t = {}); rows must be in increasing time",
+                                     io::format_number(s.t[i]), io::format_number(s.t[i - 1])));
       if (s.t[i] == s.t[i - 1])
-        throw InputError(file, i + 2, fmt::format("t = {} repeats the previous row's time; rows must be in increasing time",
-                                                  io::format_number(s.t[i])));
+        throw InputError(file, s.source_line(i), fmt::format("t = {} repeats the previous row's time; rows must be in increasing time",
+                                                             io::format_number(s.t[i])));
     }
     if (s.size() >= 3) {
       std::vector<double> dt(s.size() - 1);
       for (std::size_t i = 1; i < s.size(); ++i) dt[i - 1] = s.t[i] - s.t[i - 1];
       std::vector<double> sorted = dt;
-      std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+      std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2), sorted.end());
       const double median = sorted[sorted.size() / 2];
       std::size_t reported = 0;
       for (std::size_t i = 0; i < dt.size(); ++i)
         if (dt[i] > options.gap_factor * median && dt[i] > 0.05) {
           if (++reported <= 3)
-            diagnostics.warn(file, i + 3, fmt::format("gap of {:.3f} s in the stream (median interval {:.4f} s)", dt[i], median));
+            diagnostics.warn(file, s.source_line(i + 1),
+                             fmt::format("gap of {:.3f} s in the stream before t = {} (median interval {:.4f} s)", dt[i],
+                                         io::format_number(s.t[i + 1]), median));
         }
       if (reported > 3) diagnostics.warn(file, 0, fmt::format("{} gaps in all (only the first 3 are listed)", reported));
     }
@@ -347,10 +390,13 @@ void validate_capture(Capture& c, const fs::path& folder, Diagnostics& diagnosti
     span_hi = std::max(span_hi, s.t.back());
   }
   io::check_units(c, folder, diagnostics, options.repair_units);
+  const fs::path shots_file = c.shots_file.empty() ? folder / "shots.csv" : c.shots_file;
   for (std::size_t i = 0; i < c.shots.size(); ++i) {
     const auto& shot = c.shots[i];
+    const std::size_t line = shot.source_line != 0 ? shot.source_line : (c.shots_file.empty() ? i + 2 : 0);
+    if (!std::isfinite(shot.t)) throw InputError(shots_file, line, fmt::format("shot {} has no finite time", shot.index));
     if (!c.streams.empty() && (shot.t < span_lo || shot.t > span_hi))
-      diagnostics.warn(folder / "shots.csv", i + 2,
+      diagnostics.warn(shots_file, line,
                        fmt::format("shot {} at t = {} s lies outside the sensor data ({:.3f} … {:.3f} s): no orientation for it",
                                    shot.index, io::format_number(shot.t), span_lo, span_hi));
   }
@@ -385,6 +431,11 @@ void write_capture(const Capture& c, const fs::path& folder, const CaptureWriteO
     for (const auto& rel : c.other_files) {
       fs::create_directories((tmp / rel).parent_path());
       fs::copy_file(c.root / rel, tmp / rel, fs::copy_options::overwrite_existing);
+    }
+    for (const auto& [rel, text] : c.generated_files) {
+      if (rel.is_absolute() || rel.lexically_normal().string().starts_with(".."))
+        throw Error(fmt::format("generated file '{}' must be a path inside the capture", rel.string()));
+      io::write_text_atomic(tmp / rel, text);
     }
     if (fs::exists(folder)) {
       const fs::path old = parent / fmt::format(".{}.old-{:08x}", folder.filename().string(), rd());

@@ -30,6 +30,11 @@ struct Stream {
   std::vector<double> t;             // s, strictly increasing
   Values values;                     // size() × columns.size()
   bool gzip = false;                 // written as .csv.gz
+  /// Where the rows were read from, for messages: the file and each row's 1-based line. Empty
+  /// for streams built in memory (messages then name the native file the row would be written
+  /// to). Importers set the source file; lines only when rows map 1:1 to lines of it.
+  std::filesystem::path source_file;
+  std::vector<std::size_t> source_lines;
 
   std::size_t size() const { return t.size(); }
   bool empty() const { return t.empty(); }
@@ -38,6 +43,9 @@ struct Stream {
   /// Row i's x, y, z (requires has_xyz()).
   Vec3 xyz(std::size_t i) const { return values.row(static_cast<Eigen::Index>(i)).head<3>().transpose(); }
   double duration() const { return empty() ? 0.0 : t.back() - t.front(); }
+  /// 1-based line of row i in source_file (row index + 2 for an in-memory stream, i.e. the line
+  /// it gets when written; 0 when the source has no line per row).
+  std::size_t source_line(std::size_t i) const;
 
   /// A stream with columns x, y, z.
   static Stream vector3(std::string name, std::vector<double> t, const std::vector<Vec3>& xyz);
@@ -63,6 +71,7 @@ struct Shot {
   std::optional<double> exposure_s;
   std::vector<std::string> extra;       // values of Capture::shot_extra_columns, in order
   std::filesystem::path source;         // where to copy the image from when writing (empty: capture root)
+  std::size_t source_line = 0;          // 1-based line in Capture::shots_file (0: unknown / in memory)
 };
 
 struct Capture {
@@ -78,6 +87,8 @@ struct Capture {
   std::map<std::string, Stream> streams;  // by name
   std::vector<Shot> shots;
   std::vector<std::string> shot_extra_columns;
+  /// File the shots were read from, for messages (shots.csv, or an importer's source file).
+  std::filesystem::path shots_file;
 
   std::optional<Stream> truth_orientation;  // t,qw,qx,qy,qz[,valid,moving]; q_world_body
   std::string truth_world;                  // enu-true | enu-magnetic | unaligned
@@ -88,6 +99,10 @@ struct Capture {
   std::filesystem::path root;
   /// Other files of the folder (board.yaml, truth/scene.yaml, ...), relative to root; copied as-is.
   std::vector<std::filesystem::path> other_files;
+  /// Text files made in memory (e.g. a simulator's truth/device.yaml), relative path → content;
+  /// written after other_files (replacing a copied file of the same name). A capture read back
+  /// lists them in other_files.
+  std::map<std::filesystem::path, std::string> generated_files;
 
   const Stream* find(std::string_view name) const;
   /// The stream, or an InputError naming capture.yaml's folder and the streams it has.
@@ -123,5 +138,8 @@ void validate_capture(Capture& capture, const std::filesystem::path& folder, Dia
 
 /// Path of a stream's file inside a capture folder (sensors/<name>.csv or .csv.gz).
 std::filesystem::path stream_path(const std::filesystem::path& folder, const Stream& stream);
+
+/// The file to name in messages about a stream: its source_file, else stream_path(folder, stream).
+std::filesystem::path stream_source(const std::filesystem::path& folder, const Stream& stream);
 
 }  // namespace antpose

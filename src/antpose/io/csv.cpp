@@ -102,6 +102,18 @@ double parse_number(std::string_view text, const std::filesystem::path& file, st
   return value;
 }
 
+std::int64_t parse_int64(std::string_view text, const std::filesystem::path& file, std::size_t line, std::string_view column) {
+  std::string_view s = text;
+  if (!s.empty() && s.front() == '+') s.remove_prefix(1);
+  std::int64_t value = 0;
+  const auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), value);
+  if (s.empty() || ec == std::errc::invalid_argument || ptr != s.data() + s.size())
+    throw InputError(file, line, fmt::format("column '{}': '{}' is not an integer", column, text));
+  if (ec == std::errc::result_out_of_range)
+    throw InputError(file, line, fmt::format("column '{}': '{}' is out of the range of a 64-bit integer", column, text));
+  return value;
+}
+
 std::string format_number(double value) {
   char buffer[64];
   const auto [ptr, ec] = std::to_chars(buffer, buffer + sizeof buffer, value);

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <string_view>
@@ -37,6 +38,10 @@ enum class NonFinite { kReject, kAllow };
 /// Throws InputError "<file>:<line>: column '<column>': '<text>' is not a number" etc.
 double parse_number(std::string_view text, const std::filesystem::path& file, std::size_t line,
                     std::string_view column, NonFinite non_finite = NonFinite::kReject);
+
+/// Parses a decimal integer (Sensor Logger's ns time stamps) without going through a double,
+/// so 19-digit values keep every digit. Errors name the file, line, column and the text.
+std::int64_t parse_int64(std::string_view text, const std::filesystem::path& file, std::size_t line, std::string_view column);
 
 /// Shortest decimal text that reads back as exactly the same double.
 std::string format_number(double value);

@@ -30,8 +30,15 @@ std::string read_text(const fs::path& file) {
     if (n < 0) {
       int code = 0;
       const std::string what = gzerror(gz, &code);
+      const std::string why = code == Z_ERRNO ? std::string(std::strerror(errno)) : what;
       gzclose(gz);
-      throw InputError(file, "cannot read: " + (code == Z_ERRNO ? std::string(std::strerror(errno)) : what));
+      if (is_gzip_name(file)) throw InputError(file, "corrupt or truncated gzip data (" + why + ")");
+      throw InputError(file, "cannot read: " + why);
+    }
+    // gzread passes plain data through; a .gz name with plain content is a mislabelled file.
+    if (out.empty() && is_gzip_name(file) && gzdirect(gz) == 1) {
+      gzclose(gz);
+      throw InputError(file, "corrupt gzip data: the file has a .gz name but no gzip header");
     }
     if (n == 0) break;
     out.append(buffer, static_cast<std::size_t>(n));

@@ -44,7 +44,7 @@ void check_units(Capture& capture, const std::filesystem::path& folder, Diagnost
     auto it = capture.streams.find(std::string(check.stream));
     if (it == capture.streams.end() || !it->second.has_xyz()) continue;
     Stream& s = it->second;
-    const auto file = stream_path(folder, s);
+    const auto file = stream_source(folder, s);
     const double m = median_norm(s);
     const auto guess = check.guess(m, file);
     if (!guess) continue;
