@@ -12,4 +12,4 @@ DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recomme
   zlib1g-dev libpugixml-dev libgtest-dev libgmock-dev libbenchmark-dev
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release
 cmake --build build -j2
-./build/apps/antpose/antpose contact examples/contact-sample
+./build/apps/antpose/antpose contact examples/contact-sample --imu-calibration examples/imu-calibration-sample

@@ -23,22 +23,22 @@ struct ContactArgs {
   bool no_unit_repair = false;
 };
 
-imu::ImuCalibration load_calibration(const fs::path& path, const CaptureReadOptions& read_options,
-                                     Diagnostics& diagnostics) {
+// --imu-calibration: a device YAML file, or a recording of the phone turned in all directions.
+void load_calibration(const fs::path& path, const CaptureReadOptions& read_options, Diagnostics& diagnostics,
+                      measure::ContactOptions& options) {
   if (!fs::exists(path))
     throw InputError(path, "--imu-calibration: no such file or folder (expected a calibration capture folder or an "
                            "antpose-device YAML file)");
-  if (!fs::is_directory(path)) return imu::read_imu_calibration(path);
-  const Capture recording = read_capture(path, diagnostics, read_options);
-  const imu::HardIronEstimate hard = imu::estimate_hard_iron(recording.require(streams::kMagnetometer), {}, path);
-  fmt::print("hard iron from {}: ({:.2f}, {:.2f}, {:.2f}) µT, field {:.1f} µT, axis coverage {:.0f}/{:.0f}/{:.0f}%\n",
-             path.string(), hard.hard_iron_uT.x(), hard.hard_iron_uT.y(), hard.hard_iron_uT.z(), hard.field_uT,
-             100 * hard.coverage.x(), 100 * hard.coverage.y(), 100 * hard.coverage.z());
-  imu::ImuCalibration calibration;
-  calibration.mag_hard_iron_uT = hard.hard_iron_uT;
-  calibration.device_model = recording.device_model;
-  calibration.device_id = recording.device_id;
-  return calibration;
+  if (!fs::is_directory(path)) {
+    options.calibration = imu::read_imu_calibration(path);
+    return;
+  }
+  const imu::HardIronEstimate hard =
+      measure::calibrate_from_recording(read_capture(path, diagnostics, read_options), options);
+  fmt::print("hard iron from {}: ({:.2f}, {:.2f}, {:.2f}) µT ± {:.1f} µT, field {:.1f} µT, axis coverage "
+             "{:.0f}/{:.0f}/{:.0f}%\n",
+             path.string(), hard.hard_iron_uT.x(), hard.hard_iron_uT.y(), hard.hard_iron_uT.z(), hard.residual_uT,
+             hard.field_uT, 100 * hard.coverage.x(), 100 * hard.coverage.y(), 100 * hard.coverage.z());
 }
 
 std::string angle(const std::optional<double>& value, double sigma, int digits) {
@@ -56,7 +56,7 @@ void run_contact(const ContactArgs& args) {
   CaptureReadOptions read_options;
   read_options.repair_units = !args.no_unit_repair;
   Diagnostics diagnostics;
-  if (!args.calibration.empty()) options.calibration = load_calibration(args.calibration, read_options, diagnostics);
+  if (!args.calibration.empty()) load_calibration(args.calibration, read_options, diagnostics, options);
   const Capture capture = read_capture(args.capture, diagnostics, read_options);
   print_warnings(diagnostics);
 

@@ -49,12 +49,22 @@ struct Pose {
   ContactPlacement placement;
 };
 
+// A neutral calibration that states both sensors were calibrated (the ideal phone needs no
+// correction), so that the calibrated uncertainty floors apply.
+imu::ImuCalibration neutral_calibration() {
+  return imu::parse_imu_calibration(
+      "format: antpose-device\nversion: 1\nimu:\n  magnetometer: {hard_iron_uT: [0, 0, 0]}\n"
+      "  accelerometer: {bias_m_s2: [0, 0, 0], scale: [1, 1, 1]}\n",
+      "neutral.yaml");
+}
+
 class ContactPerfect : public ::testing::TestWithParam<Pose> {};
 
 TEST_P(ContactPerfect, RecoversTheAttitudeWithoutWarnings) {
   const Pose p = GetParam();
   ContactOptions options;
   options.placement = p.placement;
+  options.calibration = neutral_calibration();
   const auto r = measure_contact(contact_capture(p.az, p.dt, p.roll, p.placement, sim::PhoneModel::ideal()), options);
   ASSERT_TRUE(r.azimuth_true && r.azimuth_magnetic && r.roll && r.declination);
   EXPECT_NEAR(rad2deg(wrap_pi(*r.azimuth_true - deg2rad(p.az))), 0.0, 0.01);
@@ -83,6 +93,17 @@ INSTANTIATE_TEST_SUITE_P(
                       Pose{200.0, 5.0, -3.0, ContactPlacement::kTopRight},
                       Pose{300.0, 2.0, 3.0, ContactPlacement::kTopLeft}));
 
+TEST(Contact, WithoutCalibrationTheUncertaintyIsHonestAndFlagged) {
+  // The same perfect data, but nothing says the sensors were calibrated: the floors of an
+  // uncalibrated phone (8 mg accelerometer offset, 4 µT residual hard iron) apply.
+  const auto r = measure_contact(contact_capture(45.0, 6.0, -2.0, ContactPlacement::kTopUp, sim::PhoneModel::ideal()));
+  EXPECT_NEAR(rad2deg(r.sigma.downtilt), rad2deg(0.08 / 9.80665), 0.02);
+  EXPECT_GT(rad2deg(r.sigma.azimuth), 3.0);
+  ASSERT_FALSE(r.warnings.empty());
+  EXPECT_THAT(r.warnings.back(), HasSubstr("uncertain: 1σ azimuth"));
+  EXPECT_THAT(r.warnings.back(), HasSubstr("not calibrated: accelerometer, magnetometer"));
+}
+
 TEST(Contact, PlacementMismatchChangesTheAnswer) {
   // A top-down recording read as top-up is off by 180° in roll.
   const auto r = measure_contact(contact_capture(80.0, 5.0, 0.0, ContactPlacement::kTopDown, sim::PhoneModel::ideal()));
@@ -91,7 +112,10 @@ TEST(Contact, PlacementMismatchChangesTheAnswer) {
 }
 
 TEST(Contact, NoSiteGivesMagneticAzimuthOnlyAndSaysSo) {
-  const auto r = measure_contact(contact_capture(30.0, 4.0, 0.0, ContactPlacement::kTopUp, sim::PhoneModel::ideal(), std::nullopt));
+  ContactOptions options;
+  options.calibration = neutral_calibration();
+  const auto r = measure_contact(
+      contact_capture(30.0, 4.0, 0.0, ContactPlacement::kTopUp, sim::PhoneModel::ideal(), std::nullopt), options);
   EXPECT_FALSE(r.azimuth_true);
   EXPECT_FALSE(r.declination);
   ASSERT_TRUE(r.azimuth_magnetic);
@@ -314,6 +338,32 @@ TEST(ContactCli, ReadsTheSimulatorContactPreset) {
   EXPECT_NEAR(std::remainder(j["azimuth_true_deg"].get<double>(), 360.0), 0.0, 8.0);
   EXPECT_NEAR(j["downtilt_deg"].get<double>(), 0.0, 1.0);
   EXPECT_NEAR(j["roll_deg"].get<double>(), 0.0, 1.0);
+}
+
+}  // namespace
+}  // namespace antpose::measure
+
+namespace antpose::measure {
+namespace {
+
+TEST(ContactCalibration, RecordingGivesHardIronWithAnHonestResidual) {
+  sim::ImuSimulation s;
+  s.phone = sim::PhoneModel::ideal();
+  s.phone.magnetometer.noise_uT = 0.4;
+  s.phone.magnetometer.hard_iron_uT = Vec3(20.0, -10.0, 5.0);
+  s.trajectory = sim::tumble(30.0, 1.0, 5);
+  s.kind = "imu-calibration";
+  const Capture recording = sim::simulate_imu(s);
+  ContactOptions options;
+  const auto hard = calibrate_from_recording(recording, options);
+  ASSERT_TRUE(options.calibration);
+  EXPECT_EQ(options.calibration->mag_hard_iron_uT, hard.hard_iron_uT);
+  // The sphere fit uses every sample and lands on the truth; (max+min)/2 is off by about
+  // what it reports as its residual.
+  EXPECT_LT((hard.sphere_center_uT - s.phone.magnetometer.hard_iron_uT).norm(), 0.3);
+  EXPECT_LT((hard.hard_iron_uT - s.phone.magnetometer.hard_iron_uT).norm(), hard.residual_uT + 0.3);
+  EXPECT_GE(options.orientation.mag_residual_uT, hard.residual_uT);
+  EXPECT_GE(options.orientation.mag_residual_uT, 1.0);
 }
 
 }  // namespace

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include <Eigen/QR>
+
 #include <fmt/core.h>
 
 namespace antpose::imu {
@@ -37,6 +39,15 @@ HardIronEstimate estimate_hard_iron(const Stream& magnetometer, const HardIronOp
   out.field_uT = sum / n;
   out.radius_spread = out.field_uT > 0.0 ? std::sqrt(std::max(0.0, sum2 / n - out.field_uT * out.field_uT)) / out.field_uT
                                          : std::numeric_limits<double>::infinity();
+  Eigen::MatrixX4d A(magnetometer.size(), 4);
+  Eigen::VectorXd y(magnetometer.size());
+  for (std::size_t i = 0; i < magnetometer.size(); ++i) {
+    const Vec3 m = magnetometer.xyz(i);
+    A.row(static_cast<Eigen::Index>(i)) << 2.0 * m.transpose(), 1.0;
+    y(static_cast<Eigen::Index>(i)) = m.squaredNorm();
+  }
+  out.sphere_center_uT = A.colPivHouseholderQr().solve(y).head<3>();
+  out.residual_uT = (out.hard_iron_uT - out.sphere_center_uT).norm();
   out.coverage = out.field_uT > 0.0 ? Vec3(out.range_uT / (2.0 * out.field_uT)) : Vec3::Zero();
 
   // A sweep that covers only part of the sphere can still give a large range/|B| ratio when

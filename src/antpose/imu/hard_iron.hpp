@@ -6,6 +6,12 @@
 // the corrected samples, and the corrected samples to lie on a sphere (|m − b| constant within
 // max_radius_spread), which a partial sweep does not. Soft iron (an ellipsoid instead of a
 // sphere) is not estimated.
+//
+// (max+min)/2 rests on the extreme samples only: an axis whose extremes were missed by a few
+// percent shifts the centre by as much. As a check, the centre is also fitted to all samples
+// as a sphere (linear least squares on |m|² = 2 m·c + r² − |c|², e.g. Vasconcelos et al.,
+// IEEE Trans. Magn. 47(2), 2011, eq. 7 with S = I); the distance between the two centres is
+// reported as the estimate's residual, which contact mode uses as its heading-error floor.
 #pragma once
 
 #include <cstddef>
@@ -28,6 +34,8 @@ struct HardIronEstimate {
   double field_uT = 0.0;             // mean |m − b|
   Vec3 coverage = Vec3::Zero();      // range_k / (2 field_uT)
   double radius_spread = 0.0;        // std(|m − b|) / field_uT (soft iron and noise; ≈ 0.06 for 10 % soft iron)
+  Vec3 sphere_center_uT = Vec3::Zero();  // least-squares sphere centre (the cross-check)
+  double residual_uT = 0.0;          // |hard_iron − sphere_center|: how far the estimate can be trusted
   std::size_t samples = 0;
 };
 

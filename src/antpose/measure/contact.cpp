@@ -66,7 +66,16 @@ ContactResult measure_contact(const Capture& input, const ContactOptions& option
                                      "hold the phone still on the plate longer",
                                      detection.windows.front().duration(), options.min_window_s));
 
-  r.phone = orientation::estimate_static_orientation(*capture, window.t0, window.t1, options.orientation);
+  // The uncertainty floors must reflect what was calibrated, or an uncalibrated phone would
+  // report a confident σ it cannot have.
+  orientation::StaticOrientationOptions floors = options.orientation;
+  const auto* cal = options.calibration ? &*options.calibration : nullptr;
+  const YAML::Node imu_section = cal && cal->document.IsMap() ? cal->document["imu"] : YAML::Node();
+  const bool acc_calibrated = cal && (imu_section["accelerometer"] || !cal->acc_bias.isZero() || cal->acc_scale != Vec3::Ones());
+  const bool mag_calibrated = cal && (imu_section["magnetometer"] || !cal->mag_hard_iron_uT.isZero());
+  if (!acc_calibrated) floors.acc_bias_floor_mps2 = std::max(floors.acc_bias_floor_mps2, options.uncalibrated_acc_bias_mps2);
+  if (!mag_calibrated) floors.mag_residual_uT = std::max(floors.mag_residual_uT, options.uncalibrated_mag_residual_uT);
+  r.phone = orientation::estimate_static_orientation(*capture, window.t0, window.t1, floors);
   const auto& phone = r.phone;
   r.field_uT = phone.field_uT;
   r.dip = phone.dip;
@@ -162,10 +171,29 @@ ContactResult measure_contact(const Capture& input, const ContactOptions& option
   if (r.sigma.azimuth > options.uncertain_azimuth || r.sigma.downtilt > options.uncertain_tilt ||
       (r.roll && r.sigma.roll > options.uncertain_tilt))
     r.warnings.push_back(fmt::format("uncertain: 1σ azimuth {:.1f}°, downtilt {:.2f}°, roll {:.2f}° (limits {:.1f}°, "
-                                     "{:.2f}°)",
+                                     "{:.2f}°){}",
                                      rad2deg(r.sigma.azimuth), rad2deg(r.sigma.downtilt), rad2deg(r.sigma.roll),
-                                     rad2deg(options.uncertain_azimuth), rad2deg(options.uncertain_tilt)));
+                                     rad2deg(options.uncertain_azimuth), rad2deg(options.uncertain_tilt),
+                                     acc_calibrated && mag_calibrated ? std::string()
+                                     : fmt::format("; not calibrated: {} (see --imu-calibration)",
+                                                   acc_calibrated   ? "magnetometer"
+                                                   : mag_calibrated ? "accelerometer"
+                                                                    : "accelerometer, magnetometer")));
   return r;
+}
+
+imu::HardIronEstimate calibrate_from_recording(const Capture& recording, ContactOptions& options) {
+  const imu::HardIronEstimate hard =
+      imu::estimate_hard_iron(recording.require(streams::kMagnetometer), {}, recording.root);
+  imu::ImuCalibration calibration;
+  calibration.mag_hard_iron_uT = hard.hard_iron_uT;
+  calibration.device_model = recording.device_model;
+  calibration.device_id = recording.device_id;
+  calibration.document["imu"]["magnetometer"]["hard_iron_uT"] =
+      std::vector<double>{hard.hard_iron_uT.x(), hard.hard_iron_uT.y(), hard.hard_iron_uT.z()};
+  options.calibration = std::move(calibration);
+  options.orientation.mag_residual_uT = std::max(options.orientation.mag_residual_uT, hard.residual_uT);
+  return hard;
 }
 
 nlohmann::json to_json(const ContactResult& r) {

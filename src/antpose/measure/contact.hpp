@@ -25,6 +25,7 @@
 #include <nlohmann/json.hpp>
 
 #include "antpose/geometry/attitude.hpp"
+#include "antpose/imu/hard_iron.hpp"
 #include "antpose/imu/imu_calibration.hpp"
 #include "antpose/imu/static_detector.hpp"
 #include "antpose/orientation/static_orientation.hpp"
@@ -35,7 +36,12 @@ struct ContactOptions {
   ContactPlacement placement = ContactPlacement::kTopUp;
   std::optional<imu::ImuCalibration> calibration;  // applied to the streams before anything else
   imu::StaticDetectorParams detector;
-  orientation::StaticOrientationOptions orientation;
+  orientation::StaticOrientationOptions orientation;  // floors for a calibrated sensor
+  // Floors used instead for a sensor the calibration does not cover: a factory-calibrated
+  // phone accelerometer keeps a zero-g offset of tens of mg (BMI160 datasheet: ±40 mg; 8 mg
+  // 1σ after the maker's trim), an OS-calibrated magnetometer a residual hard iron of a few µT.
+  double uncalibrated_acc_bias_mps2 = 0.08;
+  double uncalibrated_mag_residual_uT = 4.0;
   double min_window_s = 2.0;                  // a shorter longest static window is warned about
   double trim_s = 0.25;                       // dropped at both ends of the window (the phone settling),
                                               // only when at least min_window_s remains
@@ -84,6 +90,13 @@ struct ContactResult {
 /// accelerometer or magnetometer stream is missing, MeasurementError when no static window
 /// is found or the field gives no heading.
 ContactResult measure_contact(const Capture& capture, const ContactOptions& options = {});
+
+/// Calibrates the magnetometer from `recording` (the phone turned in all directions) with the
+/// thesis's hard iron (max+min)/2 and sets it as `options.calibration`; the estimate's residual
+/// (distance to the least-squares sphere centre) raises the heading-error floor, so that a
+/// sweep that missed an axis's extremes does not give a confident azimuth. Throws
+/// MeasurementError when the recording does not cover enough directions.
+imu::HardIronEstimate calibrate_from_recording(const Capture& recording, ContactOptions& options);
 
 /// JSON report: azimuth_magnetic_deg, azimuth_true_deg, declination_deg, downtilt_deg,
 /// roll_deg, uncertainty_deg {azimuth, azimuth_true, downtilt, roll}, warnings, window_s,
