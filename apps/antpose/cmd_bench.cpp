@@ -1,12 +1,20 @@
 // antpose bench: benchmarks against captures with truth.
 //   antpose bench static-orientation DIR...   static eCompass on the rest phases (BROAD metric)
+//   antpose bench orientation DIR...          every orientation estimator, BROAD metric, throughput
+//   antpose bench orientation-grid DIR...     Madgwick beta × zeta sweep (thesis §4.6), SVG heat maps
 #include <algorithm>
 #include <filesystem>
+#include <map>
+#include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
+#include "antpose/io/text_file.hpp"
+#include "antpose/orientation/orientation_benchmark.hpp"
 #include "antpose/orientation/rest_benchmark.hpp"
 #include "commands.hpp"
 
@@ -64,6 +72,166 @@ void run_static_bench(const StaticBenchArgs& args) {
   print_warnings(diagnostics);
 }
 
+struct OrientationBenchArgs {
+  std::vector<std::string> dirs;
+  std::string methods;
+  std::string json;
+  std::vector<std::string> wmm;
+  double skip_s = 5.0;
+  std::string output = "orientation-grid";
+  unsigned threads = 0;
+};
+
+std::vector<geomag::MagneticModel> load_models(const std::vector<std::string>& files) {
+  std::vector<geomag::MagneticModel> models;
+  for (const auto& f : files) models.push_back(geomag::MagneticModel::from_file(f));
+  models.push_back(geomag::MagneticModel::wmm2025());
+  return models;
+}
+
+std::vector<orientation::BenchmarkTrial> load_trials(const OrientationBenchArgs& args, Diagnostics& diagnostics) {
+  const auto models = load_models(args.wmm);
+  orientation::ScoringOptions scoring;
+  scoring.skip_s = args.skip_s;
+  std::vector<orientation::BenchmarkTrial> trials;
+  for (const auto& folder : capture_folders(args.dirs))
+    trials.push_back(orientation::load_benchmark_trial(folder, models, diagnostics, scoring));
+  return trials;
+}
+
+std::vector<std::string> split_list(const std::string& text) {
+  std::vector<std::string> out;
+  std::stringstream ss(text);
+  for (std::string item; std::getline(ss, item, ',');)
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
+
+nlohmann::json score_json(const orientation::TrackScore& s) {
+  return {{"samples", s.samples},
+          {"outside_track", s.outside},
+          {"total_rmse_deg", rad2deg(s.rmse.total)},
+          {"heading_rmse_deg", rad2deg(s.rmse.heading)},
+          {"inclination_rmse_deg", rad2deg(s.rmse.inclination)},
+          {"mean_total_deg", rad2deg(s.mean_total)},
+          {"yaw_mae_deg", rad2deg(s.yaw_mae)},
+          {"pitch_mae_deg", rad2deg(s.pitch_mae)},
+          {"roll_mae_deg", rad2deg(s.roll_mae)}};
+}
+
+void run_orientation_bench(const OrientationBenchArgs& args) {
+  Diagnostics diagnostics;
+  const std::vector<std::string> methods =
+      args.methods.empty() ? orientation::estimator_names() : split_list(args.methods);
+  std::vector<std::unique_ptr<orientation::OrientationEstimator>> estimators;
+  for (const auto& m : methods) estimators.push_back(orientation::make_estimator(m));
+  const auto trials = load_trials(args, diagnostics);
+
+  // results[method][dataset] = per-trial scores, in trial order
+  std::map<std::string, std::map<std::string, std::vector<orientation::MethodScore>>> results;
+  nlohmann::json jt = nlohmann::json::array();
+  for (const auto& e : estimators) {
+    fmt::print("\n{} (default parameters for all trials); RMSE over the scored samples, degrees\n", e->name());
+    fmt::print("{:<45} {:>7} {:>8} {:>8} {:>8} {:>8} {:>10}\n", "trial", "samples", "total", "heading", "incl",
+               "mean_tot", "ns/sample");
+    std::string last_dataset;
+    for (const auto& trial : trials) {
+      Diagnostics run_diag;  // per-run warnings would repeat the data checks; keep the first method's
+      auto m = orientation::run_method(trial, *e, e == estimators.front() ? diagnostics : run_diag);
+      const auto& s = m.score;
+      fmt::print("{:<45} {:>7} {:>8.4f} {:>8.4f} {:>8.4f} {:>8.3f} {:>10.1f}\n", trial.dataset + "/" + trial.name,
+                 s.samples, rad2deg(s.rmse.total), rad2deg(s.rmse.heading), rad2deg(s.rmse.inclination),
+                 rad2deg(s.mean_total), m.ns_per_sample);
+      nlohmann::json j = score_json(s);
+      j["trial"] = m.trial;
+      j["dataset"] = m.dataset;
+      j["method"] = m.method;
+      j["protocol"] = trial.truth.protocol;
+      j["declination_deg"] = rad2deg(trial.truth.declination);
+      j["declination_model"] = trial.truth.declination_model;
+      j["track_samples"] = m.track_samples;
+      j["ns_per_sample"] = m.ns_per_sample;
+      jt.push_back(j);
+      results[e->name()][trial.dataset].push_back(std::move(m));
+    }
+    for (const auto& [dataset, scores] : results[e->name()]) {
+      const auto mean = orientation::mean_score(scores);
+      double ns = 0.0;
+      for (const auto& s : scores) ns += s.ns_per_sample;
+      fmt::print("{:<45} {:>7} {:>8.4f} {:>8.4f} {:>8.4f} {:>8.3f} {:>10.1f}\n",
+                 fmt::format("mean of {} {} trials", scores.size(), dataset), "", rad2deg(mean.rmse.total),
+                 rad2deg(mean.rmse.heading), rad2deg(mean.rmse.inclination), rad2deg(mean.mean_total),
+                 ns / static_cast<double>(scores.size()));
+    }
+  }
+  if (!args.json.empty()) {
+    nlohmann::json means = nlohmann::json::object();
+    for (const auto& [method, by_dataset] : results)
+      for (const auto& [dataset, scores] : by_dataset) {
+        nlohmann::json j = score_json(orientation::mean_score(scores));
+        double ns = 0.0;
+        for (const auto& s : scores) ns += s.ns_per_sample;
+        j["trials"] = scores.size();
+        j["ns_per_sample"] = ns / static_cast<double>(scores.size());
+        means[dataset][method] = j;
+      }
+    const nlohmann::json out = {{"metric", "BROAD (total/heading/inclination RMSE); Tyrex-style mean total"},
+                                {"methods", methods},
+                                {"trials", jt},
+                                {"means", means}};
+    io::write_text_atomic(args.json, out.dump(2) + "\n");
+    fmt::print("\nJSON written to {}\n", args.json);
+  }
+  print_warnings(diagnostics);
+}
+
+void run_orientation_grid(const OrientationBenchArgs& args) {
+  Diagnostics diagnostics;
+  const auto trials = load_trials(args, diagnostics);
+  std::vector<double> beta, zeta;
+  for (int i = 0; i <= 10; ++i) beta.push_back(0.1 * i), zeta.push_back(0.01 * i);
+  const unsigned threads = args.threads > 0 ? args.threads : std::max(1u, std::thread::hardware_concurrency());
+  fmt::print("Madgwick MARG over beta 0..1 (step 0.1) × zeta 0..0.1 (step 0.01) on {} trials, {} threads\n",
+             trials.size(), threads);
+  const auto g = orientation::madgwick_grid(trials, beta, zeta, threads);
+  const std::filesystem::path out(args.output);
+  std::filesystem::create_directories(out);
+  struct Item {
+    const char* file;
+    const char* title;
+    const Eigen::MatrixXd* values;
+  };
+  const Item items[] = {{"yaw_mae.svg", "yaw (azimuth) mean absolute error", &g.yaw_mae},
+                        {"pitch_mae.svg", "pitch mean absolute error", &g.pitch_mae},
+                        {"roll_mae.svg", "roll mean absolute error", &g.roll_mae},
+                        {"pitch_roll_mae.svg", "pitch + roll mean absolute error", &g.pitch_roll_mae}};
+  nlohmann::json j = {{"beta", beta}, {"zeta", zeta}, {"trials", g.trials}};
+  for (const auto& it : items) {
+    orientation::Heatmap map;
+    map.title = fmt::format("Madgwick MARG: {} (mean of {} trials)", it.title, g.trials);
+    map.x_label = "zeta (rad/s²)";
+    map.y_label = "beta (rad/s)";
+    map.unit = "°";
+    map.x_values = zeta;
+    map.y_values = beta;
+    map.values = it.values->unaryExpr([](double v) { return rad2deg(v); });
+    io::write_text_atomic(out / it.file, orientation::heatmap_svg(map));
+    Eigen::Index r = 0, c = 0;
+    const double best = map.values.minCoeff(&r, &c);
+    fmt::print("{:<36} best {:.3f}° at beta {:.1f}, zeta {:.2f}  -> {}\n", it.title, best, beta[r], zeta[c],
+               (out / it.file).string());
+    std::vector<std::vector<double>> rows;
+    for (Eigen::Index i = 0; i < map.values.rows(); ++i) {
+      std::vector<double> row;
+      for (Eigen::Index k = 0; k < map.values.cols(); ++k) row.push_back(map.values(i, k));
+      rows.push_back(row);
+    }
+    j[std::string(it.file).substr(0, std::string(it.file).size() - 4) + "_deg"] = rows;
+  }
+  io::write_text_atomic(out / "grid.json", j.dump(2) + "\n");
+  print_warnings(diagnostics);
+}
+
 }  // namespace
 
 void add_bench_command(CLI::App& app) {
@@ -76,6 +244,30 @@ void add_bench_command(CLI::App& app) {
   st->add_option("--rest-s", args->rest_s, "seconds of rest scored per trial")->capture_default_str();
   st->add_option("--window-s", args->window_s, "averaging window per scored sample, s")->capture_default_str();
   st->callback([args] { run_static_bench(*args); });
+
+  auto oargs = std::make_shared<OrientationBenchArgs>();
+  auto* ob = bench->add_subcommand("orientation", "score every orientation estimator against captures with truth");
+  ob->add_option("dirs", oargs->dirs, "capture folders, or folders of capture folders")->required();
+  ob->add_option("--methods", oargs->methods,
+                 fmt::format("comma-separated estimators (default: all: {})",
+                             fmt::join(orientation::estimator_names(), ",")));
+  ob->add_option("--json", oargs->json, "write the per-trial and mean results as JSON");
+  ob->add_option("--wmm", oargs->wmm, "extra WMM coefficient files for the declination (repeatable; with the built-in "
+                                      "WMM2025, the model valid for the capture date is used, else the nearest epoch)");
+  ob->add_option("--skip-s", oargs->skip_s, "truth without a moving column: seconds left out at its start")
+      ->capture_default_str();
+  ob->callback([oargs] { run_orientation_bench(*oargs); });
+
+  auto gargs = std::make_shared<OrientationBenchArgs>();
+  auto* og = bench->add_subcommand("orientation-grid",
+                                   "Madgwick beta × zeta sweep (thesis §4.6): yaw/pitch/roll MAE heat maps as SVG");
+  og->add_option("dirs", gargs->dirs, "capture folders, or folders of capture folders")->required();
+  og->add_option("-o,--output", gargs->output, "output folder for the SVG files and grid.json")->capture_default_str();
+  og->add_option("--wmm", gargs->wmm, "extra WMM coefficient files for the declination (repeatable)");
+  og->add_option("--skip-s", gargs->skip_s, "truth without a moving column: seconds left out at its start")
+      ->capture_default_str();
+  og->add_option("--threads", gargs->threads, "worker threads (0: all cores)")->capture_default_str();
+  og->callback([gargs] { run_orientation_grid(*gargs); });
 }
 
 }  // namespace antpose::cli

@@ -13,6 +13,8 @@ void add_wmm_command(CLI::App& app);
 void add_contact_command(CLI::App& app);
 void add_simulate_command(CLI::App& app);
 void add_bench_command(CLI::App& app);
+void add_orientation_command(CLI::App& app);
+void add_calibrate_command(CLI::App& app);
 
 /// Prints each warning as "warning: <file>:<line>: <message>" on stderr.
 void print_warnings(const Diagnostics& diagnostics);

@@ -61,10 +61,36 @@ const YAML::Node section(const YAML::Node& parent, const char* key, const fs::pa
   return node;
 }
 
+Vec3 scale(const YAML::Node& node, const fs::path& file, const std::string& key) {
+  const Vec3 k = vec3(node, file, key);
+  if (k.minCoeff() < 0.5 || k.maxCoeff() > 2.0)
+    throw InputError(file, line_of(node), fmt::format("{} = [{}], expected factors between 0.5 and 2", key, fmt::join(k, ", ")));
+  return k;
+}
+
+// A misalignment matrix has a unit diagonal and small off-diagonal entries (≈ angles in rad);
+// 0.2 rad (11°) is far beyond any real sensor's non-orthogonality.
+Mat3 misalignment(const YAML::Node& node, const fs::path& file, const std::string& key) {
+  const Mat3 T = mat3(node, file, key);
+  const Mat3 off = T - Mat3::Identity();
+  if ((T.diagonal() - Vec3::Ones()).cwiseAbs().maxCoeff() > 1e-9 || off.cwiseAbs().maxCoeff() > 0.2)
+    throw InputError(file, line_of(node),
+                     fmt::format("{} has diagonal [{}] and largest off-diagonal {:.3g}; expected a unit diagonal and "
+                                 "off-diagonal entries below 0.2 (small angles in rad)",
+                                 key, fmt::join(T.diagonal(), ", "), off.cwiseAbs().maxCoeff()));
+  return T;
+}
+
 YAML::Node flow_vector(const Vec3& v) {
   YAML::Node n(YAML::NodeType::Sequence);
   for (int k = 0; k < 3; ++k) n.push_back(io::format_number(v[k]));
   n.SetStyle(YAML::EmitterStyle::Flow);
+  return n;
+}
+
+YAML::Node flow_matrix(const Mat3& M) {
+  YAML::Node n(YAML::NodeType::Sequence);
+  for (int r = 0; r < 3; ++r) n.push_back(flow_vector(M.row(r).transpose()));
   return n;
 }
 
@@ -109,6 +135,8 @@ ImuCalibration parse_imu_calibration(const std::string& text, const fs::path& fi
                                      "was it written in nT?",
                                      c.mag_hard_iron_uT.norm()));
     }
+    if (mag["field_uT"]) c.mag_field_uT = number(mag["field_uT"], file, "imu.magnetometer.field_uT");
+    if (mag["residual_rel"]) c.mag_residual_rel = number(mag["residual_rel"], file, "imu.magnetometer.residual_rel");
     if (mag["soft_iron"]) {
       c.mag_soft_iron = mat3(mag["soft_iron"], file, "imu.magnetometer.soft_iron");
       const double det = c.mag_soft_iron.determinant();
@@ -121,16 +149,17 @@ ImuCalibration parse_imu_calibration(const std::string& text, const fs::path& fi
   }
   if (const auto acc = section(imu, "accelerometer", file, "imu.accelerometer")) {
     if (acc["bias_m_s2"]) c.acc_bias = vec3(acc["bias_m_s2"], file, "imu.accelerometer.bias_m_s2");
-    if (acc["scale"]) {
-      c.acc_scale = vec3(acc["scale"], file, "imu.accelerometer.scale");
-      if (c.acc_scale.minCoeff() < 0.5 || c.acc_scale.maxCoeff() > 2.0)
-        throw InputError(file, line_of(acc["scale"]),
-                         fmt::format("imu.accelerometer.scale = [{}], expected factors between 0.5 and 2",
-                                     fmt::join(c.acc_scale, ", ")));
-    }
+    if (acc["scale"]) c.acc_scale = scale(acc["scale"], file, "imu.accelerometer.scale");
+    if (acc["misalignment"]) c.acc_misalignment = misalignment(acc["misalignment"], file, "imu.accelerometer.misalignment");
+    if (acc["residual_rms_m_s2"])
+      c.acc_residual_rms_m_s2 = number(acc["residual_rms_m_s2"], file, "imu.accelerometer.residual_rms_m_s2");
   }
   if (const auto gyr = section(imu, "gyroscope", file, "imu.gyroscope")) {
     if (gyr["bias_rad_s"]) c.gyro_bias = vec3(gyr["bias_rad_s"], file, "imu.gyroscope.bias_rad_s");
+    if (gyr["scale"]) c.gyro_scale = scale(gyr["scale"], file, "imu.gyroscope.scale");
+    if (gyr["misalignment"]) c.gyro_misalignment = misalignment(gyr["misalignment"], file, "imu.gyroscope.misalignment");
+    if (gyr["residual_rms_deg"])
+      c.gyro_residual_rms_deg = number(gyr["residual_rms_deg"], file, "imu.gyroscope.residual_rms_deg");
   }
   return c;
 }
@@ -144,13 +173,36 @@ std::string format_imu_calibration(const ImuCalibration& c) {
   if (!c.device_model.empty()) d["device"]["model"] = c.device_model;
   if (!c.device_id.empty()) d["device"]["id"] = c.device_id;
   YAML::Node imu = d["imu"];
-  imu["magnetometer"]["hard_iron_uT"] = flow_vector(c.mag_hard_iron_uT);
-  YAML::Node soft(YAML::NodeType::Sequence);
-  for (int r = 0; r < 3; ++r) soft.push_back(flow_vector(c.mag_soft_iron.row(r).transpose()));
-  imu["magnetometer"]["soft_iron"] = soft;
-  imu["accelerometer"]["bias_m_s2"] = flow_vector(c.acc_bias);
-  imu["accelerometer"]["scale"] = flow_vector(c.acc_scale);
-  imu["gyroscope"]["bias_rad_s"] = flow_vector(c.gyro_bias);
+  // A sensor's section is written when it was in the file or holds a calibration, so that a
+  // file calibrating only some sensors does not claim the others (readers such as the contact
+  // measurement test for the section's presence).
+  YAML::Node old_imu;
+  if (c.document.IsMap()) {
+    const YAML::Node n = c.document["imu"];
+    if (n && n.IsMap()) old_imu = n;
+  }
+  auto keep = [&](const char* key, bool calibrated) { return calibrated || (old_imu.IsMap() && old_imu[key]); };
+  if (keep("magnetometer", !c.mag_hard_iron_uT.isZero() || c.mag_soft_iron != Mat3::Identity() || c.mag_field_uT)) {
+    imu["magnetometer"]["hard_iron_uT"] = flow_vector(c.mag_hard_iron_uT);
+    imu["magnetometer"]["soft_iron"] = flow_matrix(c.mag_soft_iron);
+    if (c.mag_field_uT) imu["magnetometer"]["field_uT"] = io::format_number(*c.mag_field_uT);
+    if (c.mag_residual_rel) imu["magnetometer"]["residual_rel"] = io::format_number(*c.mag_residual_rel);
+  }
+  if (keep("accelerometer", !c.acc_bias.isZero() || c.acc_scale != Vec3::Ones() || c.acc_misalignment != Mat3::Identity() ||
+                                c.acc_residual_rms_m_s2)) {
+    imu["accelerometer"]["bias_m_s2"] = flow_vector(c.acc_bias);
+    imu["accelerometer"]["scale"] = flow_vector(c.acc_scale);
+    imu["accelerometer"]["misalignment"] = flow_matrix(c.acc_misalignment);
+    if (c.acc_residual_rms_m_s2) imu["accelerometer"]["residual_rms_m_s2"] = io::format_number(*c.acc_residual_rms_m_s2);
+  }
+  if (keep("gyroscope", !c.gyro_bias.isZero() || c.gyro_scale != Vec3::Ones() || c.gyro_misalignment != Mat3::Identity() ||
+                            c.gyro_residual_rms_deg)) {
+    imu["gyroscope"]["bias_rad_s"] = flow_vector(c.gyro_bias);
+    imu["gyroscope"]["scale"] = flow_vector(c.gyro_scale);
+    imu["gyroscope"]["misalignment"] = flow_matrix(c.gyro_misalignment);
+    if (c.gyro_residual_rms_deg) imu["gyroscope"]["residual_rms_deg"] = io::format_number(*c.gyro_residual_rms_deg);
+  }
+  if (!imu.IsMap() || imu.size() == 0) d["imu"] = YAML::Node(YAML::NodeType::Map);
   YAML::Emitter out;
   out << d;
   return std::string(out.c_str()) + "\n";
@@ -170,9 +222,9 @@ void apply(const ImuCalibration& c, Capture& capture) {
       s.values.row(i).head<3>() = f(v).transpose();
     }
   };
-  correct(streams::kMagnetometer, [&](const Vec3& m) -> Vec3 { return c.mag_soft_iron * (m - c.mag_hard_iron_uT); });
-  correct(streams::kAccelerometer, [&](const Vec3& a) -> Vec3 { return c.acc_scale.cwiseProduct(a - c.acc_bias); });
-  correct(streams::kGyroscope, [&](const Vec3& w) -> Vec3 { return w - c.gyro_bias; });
+  correct(streams::kMagnetometer, [&](const Vec3& m) -> Vec3 { return c.correct_mag(m); });
+  correct(streams::kAccelerometer, [&](const Vec3& a) -> Vec3 { return c.correct_acc(a); });
+  correct(streams::kGyroscope, [&](const Vec3& w) -> Vec3 { return c.correct_gyro(w); });
 }
 
 }  // namespace antpose::imu

@@ -1,0 +1,119 @@
+// antpose calibrate: per-device sensor calibration.
+//   antpose calibrate imu CAPTURE -o device.yaml [--sensors acc,gyro,mag] [--method thesis|full] [--force]
+//   antpose calibrate allan CAPTURE [--stream gyroscope] [--json OUT] [--plot OUT.svg]
+#include <filesystem>
+#include <optional>
+#include <string>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "antpose/calibration/allan.hpp"
+#include "antpose/calibration/calibrate_imu.hpp"
+#include "antpose/io/text_file.hpp"
+#include "commands.hpp"
+
+namespace antpose::cli {
+namespace {
+namespace fs = std::filesystem;
+
+struct ImuArgs {
+  std::string capture, output;
+  std::string sensors = "acc,gyro,mag";
+  std::string method = "full";
+  std::optional<double> gravity;
+  bool force = false;
+};
+
+void run_imu(const ImuArgs& args) {
+  calibration::CalibrateImuOptions options;
+  calibration::parse_sensors(args.sensors, options);
+  options.method = calibration::parse_method(args.method);
+  options.gravity = args.gravity;
+  Diagnostics diagnostics;
+  calibration::CalibrateImuResult result;
+  try {
+    result = calibration::calibrate_imu_file(args.capture, args.output, options, args.force, diagnostics);
+  } catch (...) {
+    print_warnings(diagnostics);
+    throw;
+  }
+  print_warnings(diagnostics);
+  fmt::print("IMU calibration of {} (method {})\n{}wrote {}\n", args.capture, args.method, calibration::describe(result),
+             args.output);
+}
+
+struct AllanArgs {
+  std::string capture, stream = "gyroscope", json, plot;
+  int per_decade = 10;
+};
+
+void run_allan(const AllanArgs& args) {
+  Diagnostics diagnostics;
+  const Capture capture = read_capture(args.capture, diagnostics);
+  const Stream& stream = capture.require(args.stream);
+  const auto a = calibration::allan_of_stream(stream, diagnostics, args.capture, args.per_decade);
+  print_warnings(diagnostics);
+  const std::string unit = args.stream == streams::kGyroscope       ? "rad/s"
+                           : args.stream == streams::kAccelerometer ? "m/s²"
+                           : args.stream == streams::kMagnetometer  ? "µT"
+                                                                    : "unit";
+  fmt::print("overlapping Allan deviation of '{}' ({} samples, tau0 {:.5f} s, {:.0f} s), unit {}\n", args.stream,
+             stream.size(), a.tau0, stream.duration(), unit);
+  fmt::print("{:<6} {:>14} {:>14} {:>10} {:>14}\n", "axis", "N (·√s)", "B", "tau_B s", "K (/√s)");
+  auto opt = [](const std::optional<double>& v) { return v ? fmt::format("{:.4e}", *v) : std::string("-"); };
+  nlohmann::json j;
+  j["stream"] = args.stream;
+  j["tau0_s"] = a.tau0;
+  j["unit"] = unit;
+  std::vector<calibration::AllanSeries> series;
+  for (std::size_t k = 0; k < a.axes.size(); ++k) {
+    const auto& f = a.fits[k];
+    fmt::print("{:<6} {:>14} {:>14} {:>10} {:>14}\n", a.axes[k], opt(f.white), opt(f.bias_instability),
+               f.bias_instability_tau ? fmt::format("{:.2f}", *f.bias_instability_tau) : "-", opt(f.random_walk));
+    nlohmann::json axis;
+    axis["axis"] = a.axes[k];
+    for (const auto& p : a.curves[k]) axis["curve"].push_back({{"m", p.m}, {"tau_s", p.tau}, {"n", p.n}, {"oadev", p.deviation}});
+    if (f.white) axis["white_noise"] = *f.white;
+    if (f.bias_instability) axis["bias_instability"] = *f.bias_instability;
+    if (f.bias_instability_tau) axis["bias_instability_tau_s"] = *f.bias_instability_tau;
+    if (f.random_walk) axis["random_walk"] = *f.random_walk;
+    j["axes"].push_back(axis);
+    series.push_back({args.stream + " " + a.axes[k], a.curves[k], f});
+  }
+  if (!args.json.empty()) io::write_text_atomic(args.json, j.dump(2) + "\n");
+  if (!args.plot.empty())
+    io::write_text_atomic(args.plot, calibration::allan_svg(series, "Overlapping Allan deviation: " + args.capture, unit));
+}
+
+}  // namespace
+
+void add_calibrate_command(CLI::App& app) {
+  auto* cmd = app.add_subcommand("calibrate", "per-device sensor calibration");
+  cmd->require_subcommand(1);
+
+  auto imu_args = std::make_shared<ImuArgs>();
+  auto* imu = cmd->add_subcommand("imu", "accelerometer, gyroscope and magnetometer calibration from an "
+                                         "imu-calibration capture; writes the device YAML");
+  imu->add_option("capture", imu_args->capture, "imu-calibration capture folder")->required();
+  imu->add_option("-o,--output", imu_args->output, "device calibration YAML to write")->required();
+  imu->add_option("--sensors", imu_args->sensors, "comma-separated subset of acc,gyro,mag")->capture_default_str();
+  imu->add_option("--method", imu_args->method, "thesis (normalization, bias, hard iron) or full (9-parameter models, "
+                                                "ellipsoid)")
+      ->capture_default_str();
+  imu->add_option("--gravity", imu_args->gravity, "local gravity, m/s² (default: normal gravity at the capture's site, "
+                                                  "else 9.80665)");
+  imu->add_flag("--force", imu_args->force, "ignore (and replace) an existing output file instead of updating it");
+  imu->callback([imu_args] { run_imu(*imu_args); });
+
+  auto allan_args = std::make_shared<AllanArgs>();
+  auto* allan = cmd->add_subcommand("allan", "overlapping Allan deviation and noise fit of a static log");
+  allan->add_option("capture", allan_args->capture, "capture folder (a long static recording)")->required();
+  allan->add_option("--stream", allan_args->stream, "stream to analyse")->capture_default_str();
+  allan->add_option("--json", allan_args->json, "write the curves and fits as JSON");
+  allan->add_option("--plot", allan_args->plot, "write a log-log SVG plot");
+  allan->add_option("--per-decade", allan_args->per_decade, "averaging times per decade")->capture_default_str();
+  allan->callback([allan_args] { run_allan(*allan_args); });
+}
+
+}  // namespace antpose::cli

@@ -1,0 +1,188 @@
+#include "antpose/calibration/magnetometer.hpp"
+
+#include <array>
+#include <cmath>
+
+#include <ceres/ceres.h>
+#include <Eigen/Dense>
+#include <fmt/format.h>
+
+namespace antpose::calibration {
+namespace {
+
+std::string prefix(const std::filesystem::path& source) { return source.empty() ? "" : source.string() + ": "; }
+
+// std/mean of ‖f(m_i)‖.
+template <typename F>
+std::pair<double, double> norm_stats(const std::vector<Vec3>& m, F&& f) {
+  double s = 0.0, ss = 0.0;
+  for (const auto& v : m) {
+    const double n = f(v).norm();
+    s += n;
+    ss += n * n;
+  }
+  const double N = static_cast<double>(m.size());
+  const double mean = s / N;
+  return {mean, std::sqrt(std::max(0.0, ss / N - mean * mean))};
+}
+
+struct EllipsoidResidual {
+  explicit EllipsoidResidual(const Vec3& m) : m_(m) {}
+  template <typename T>
+  bool operator()(const T* const b, const T* const s, const T* const f, T* r) const {
+    // s = (s00, s01, s02, s11, s12, s22), symmetric S; det-normalised so F carries the scale.
+    const T d0 = T(m_[0]) - b[0], d1 = T(m_[1]) - b[1], d2 = T(m_[2]) - b[2];
+    const T det = s[0] * (s[3] * s[5] - s[4] * s[4]) - s[1] * (s[1] * s[5] - s[4] * s[2]) + s[2] * (s[1] * s[4] - s[3] * s[2]);
+    const T c = T(1) / ceres::cbrt(det);
+    const T v0 = c * (s[0] * d0 + s[1] * d1 + s[2] * d2);
+    const T v1 = c * (s[1] * d0 + s[3] * d1 + s[4] * d2);
+    const T v2 = c * (s[2] * d0 + s[4] * d1 + s[5] * d2);
+    r[0] = ceres::sqrt(v0 * v0 + v1 * v1 + v2 * v2) - f[0];
+    return true;
+  }
+  Vec3 m_;
+};
+
+// Index of the nearest of the 26 directions (±1, 0)³ \ 0.
+int direction_bin(const Vec3& u) {
+  int best = 0, idx = 0;
+  double best_dot = -2.0;
+  for (int i = -1; i <= 1; ++i)
+    for (int j = -1; j <= 1; ++j)
+      for (int k = -1; k <= 1; ++k) {
+        if (i == 0 && j == 0 && k == 0) continue;
+        const double d = Vec3(i, j, k).normalized().dot(u);
+        if (d > best_dot) best_dot = d, best = idx;
+        ++idx;
+      }
+  return best;
+}
+
+}  // namespace
+
+MagnetometerCalibration fit_magnetometer(const Stream& stream, const MagnetometerOptions& options, Diagnostics& diagnostics,
+                                         const std::filesystem::path& source) {
+  MagnetometerCalibration c;
+  std::vector<Vec3> m;
+  m.reserve(stream.size());
+  for (std::size_t i = 0; i < stream.size(); ++i) {
+    const Vec3 v = stream.xyz(i);
+    if (v.allFinite()) m.push_back(v);
+  }
+  c.samples = m.size();
+  if (m.size() < options.min_samples)
+    throw MeasurementError(prefix(source) + fmt::format("magnetometer calibration: {} samples, need at least {}; turn the "
+                                                        "device slowly through all orientations for about 30 s",
+                                                        m.size(), options.min_samples));
+  Vec3 lo = m[0], hi = m[0];
+  for (const auto& v : m) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
+  c.max_min_hard_iron_uT = 0.5 * (lo + hi);
+  {
+    const auto [mean, sd] = norm_stats(m, [](const Vec3& v) { return v; });
+    c.residual_rel_raw = sd / mean;
+    const auto [mean_h, sd_h] = norm_stats(m, [&](const Vec3& v) { return Vec3(v - c.max_min_hard_iron_uT); });
+    c.residual_rel_hard_iron = sd_h / mean_h;
+  }
+
+  // Coverage around the (max+min)/2 centre: a rotation about one axis leaves the field
+  // directions on a cone/plane, from which no ellipsoid (and no soft iron) is determined.
+  {
+    Mat3 scatter = Mat3::Zero();
+    std::array<int, 26> bins{};
+    for (const auto& v : m) {
+      const Vec3 d = v - c.max_min_hard_iron_uT;
+      if (d.norm() <= 0) continue;
+      const Vec3 u = d.normalized();
+      scatter += u * u.transpose();
+      bins[static_cast<std::size_t>(direction_bin(u))] = 1;
+    }
+    scatter /= static_cast<double>(m.size());
+    c.spread = Eigen::SelfAdjointEigenSolver<Mat3>(scatter).eigenvalues()[0];
+    int hit = 0;
+    for (int b : bins) hit += b;
+    c.direction_coverage = hit / 26.0;
+    if (c.spread < options.min_spread)
+      throw MeasurementError(prefix(source) + fmt::format(
+          "magnetometer calibration: poor coverage — the field directions span only {:.0f}% of the sphere's "
+          "directions and lie close to a plane (smallest spread {:.3f}, need ≥ {:.3f}; a full sphere gives 0.333); "
+          "the device was turned about one axis only. Turn it through all orientations (figure-eight, every face up)",
+          100 * c.direction_coverage, c.spread, options.min_spread));
+    if (c.direction_coverage < options.warn_direction_coverage)
+      diagnostics.warn(source, 0, fmt::format("magnetometer coverage is poor: the field directions reach {:.0f}% of 26 "
+                                              "direction bins (want ≥ {:.0f}%); the soft iron may be inaccurate",
+                                              100 * c.direction_coverage, 100 * options.warn_direction_coverage));
+  }
+
+  // 1. Algebraic fit on centred, scaled samples (conditioning).
+  Vec3 centre = Vec3::Zero();
+  for (const auto& v : m) centre += v;
+  centre /= static_cast<double>(m.size());
+  double scale = 0.0;
+  for (const auto& v : m) scale += (v - centre).squaredNorm();
+  scale = std::sqrt(scale / static_cast<double>(m.size()));
+  Eigen::Matrix<double, 10, 10> DtD = Eigen::Matrix<double, 10, 10>::Zero();
+  for (const auto& v : m) {
+    const Vec3 p = (v - centre) / scale;
+    Eigen::Matrix<double, 10, 1> d;
+    d << p.x() * p.x(), p.y() * p.y(), p.z() * p.z(), 2 * p.x() * p.y(), 2 * p.x() * p.z(), 2 * p.y() * p.z(), 2 * p.x(),
+        2 * p.y(), 2 * p.z(), 1.0;
+    DtD += d * d.transpose();
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 10, 10>> es(DtD);
+  const Eigen::Matrix<double, 10, 1> v = es.eigenvectors().col(0);
+  Mat3 Q;
+  Q << v[0], v[3], v[4], v[3], v[1], v[5], v[4], v[5], v[2];
+  const Vec3 u(v[6], v[7], v[8]);
+  const Vec3 p0 = -Q.ldlt().solve(u);
+  const double r = p0.dot(Q * p0) - v[9];
+  Mat3 M = Q / r;
+  const Eigen::SelfAdjointEigenSolver<Mat3> em(M);
+  if (!(em.eigenvalues().minCoeff() > 0.0) || !std::isfinite(r))
+    throw MeasurementError(prefix(source) + fmt::format(
+        "magnetometer calibration: the samples do not lie on an ellipsoid (quadric eigenvalues {:.3g}, {:.3g}, {:.3g}); "
+        "the coverage is too poor or the field was disturbed (steel, magnets) during the recording",
+        em.eigenvalues()[0], em.eigenvalues()[1], em.eigenvalues()[2]));
+  c.hard_iron_uT = centre + scale * p0;
+  M /= scale * scale;
+  const Eigen::SelfAdjointEigenSolver<Mat3> eM(M);
+  c.field_uT = std::pow(eM.eigenvalues().prod(), -1.0 / 6.0);
+  c.semi_axes_uT = eM.eigenvalues().cwiseSqrt().cwiseInverse().reverse();
+  c.soft_iron = c.field_uT * eM.operatorSqrt();
+
+  // 3. Geometric refinement.
+  if (options.refine) {
+    double b[3] = {c.hard_iron_uT[0], c.hard_iron_uT[1], c.hard_iron_uT[2]};
+    double s[6] = {c.soft_iron(0, 0), c.soft_iron(0, 1), c.soft_iron(0, 2), c.soft_iron(1, 1), c.soft_iron(1, 2), c.soft_iron(2, 2)};
+    double f = c.field_uT;
+    ceres::Problem problem;
+    for (const auto& x : m)
+      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<EllipsoidResidual, 1, 3, 6, 1>(new EllipsoidResidual(x)),
+                               nullptr, b, s, &f);
+    ceres::Solver::Options so;
+    so.linear_solver_type = ceres::DENSE_QR;
+    so.max_num_iterations = 50;
+    so.logging_type = ceres::SILENT;
+    ceres::Solver::Summary summary;
+    ceres::Solve(so, &problem, &summary);
+    Mat3 S;
+    S << s[0], s[1], s[2], s[1], s[3], s[4], s[2], s[4], s[5];
+    const double det = S.determinant();
+    if (summary.IsSolutionUsable() && det > 0 && f > 0) {
+      c.hard_iron_uT = Vec3(b[0], b[1], b[2]);
+      c.soft_iron = S / std::cbrt(det);
+      c.field_uT = f;
+      const Eigen::SelfAdjointEigenSolver<Mat3> eS(c.soft_iron);
+      c.semi_axes_uT = (c.field_uT * eS.eigenvalues().cwiseInverse());
+      std::sort(c.semi_axes_uT.data(), c.semi_axes_uT.data() + 3);
+    }
+  }
+  double ss = 0.0;
+  for (const auto& x : m) ss += std::pow(c.correct(x).norm() - c.field_uT, 2);
+  c.residual_rms_uT = std::sqrt(ss / static_cast<double>(m.size()));
+  const auto [mean_c, sd_c] = norm_stats(m, [&](const Vec3& x) { return c.correct(x); });
+  c.residual_rel = sd_c / c.field_uT;
+  (void)mean_c;
+  return c;
+}
+
+}  // namespace antpose::calibration

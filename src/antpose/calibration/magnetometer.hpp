@@ -1,0 +1,58 @@
+// Magnetometer hard- and soft-iron calibration from a recording in which the device was turned
+// through all orientations (the field vector then sweeps an ellipsoid).
+//
+// Model (imu::ImuCalibration): m = S (m_raw − b), S symmetric positive definite.
+//  1. Algebraic ellipsoid fit: the general quadric pᵀQp + 2uᵀp + k = 0 through the samples by
+//     total least squares (smallest eigenvector of DᵀD, D the 10-column design matrix of the
+//     centred and scaled samples; cf. Li & Griffiths, "Least squares ellipsoid specific
+//     fitting", GMP 2004, without their 4J − I² constraint, which coverage checks replace).
+//     Centre b = −Q⁻¹u; M = Q / (bᵀQb − k) must be positive definite (otherwise the samples
+//     are no ellipsoid: poor coverage or disturbances).
+//  2. S = F · M^½ (symmetric square root), F = det(M)^(−1/6) the geometric mean of the
+//     semi-axes, so det S = 1 (S changes the shape, not the volume) and ‖S (m − b)‖ = F, the
+//     fitted field strength.
+//  3. Optional Ceres (LM) refinement of the geometric residual ‖S (m − b)‖ − F over b, the 6
+//     entries of a symmetric S (normalised to det S = 1) and F.
+// The thesis's hard iron (max + min)/2 is imu::estimate_hard_iron.
+#pragma once
+
+#include <cstddef>
+#include <string>
+
+#include "antpose/core/error.hpp"
+#include "antpose/io/capture.hpp"
+
+namespace antpose::calibration {
+
+struct MagnetometerOptions {
+  bool refine = true;               // step 3
+  std::size_t min_samples = 50;
+  double min_spread = 0.02;         // smallest eigenvalue of E[u uᵀ] of the field directions (1/3 for a full sphere, 0 for a plane)
+  double warn_direction_coverage = 0.6;  // warn below this fraction of the 26 direction bins (cube faces, edges, corners)
+};
+
+struct MagnetometerCalibration {
+  Vec3 hard_iron_uT = Vec3::Zero();     // b
+  Mat3 soft_iron = Mat3::Identity();    // S (symmetric, det 1)
+  double field_uT = 0.0;                // F
+  Vec3 semi_axes_uT = Vec3::Zero();     // of the raw ellipsoid, ascending
+  std::size_t samples = 0;
+  double direction_coverage = 0.0;      // fraction of the 26 direction bins with samples
+  double spread = 0.0;                  // smallest eigenvalue of E[u uᵀ]
+  // Residuals: std(|m|)/mean(|m|) raw; after the (max+min)/2 hard iron; after the ellipsoid.
+  double residual_rel_raw = 0.0;
+  double residual_rel_hard_iron = 0.0;
+  double residual_rel = 0.0;            // std(‖S(m − b)‖) / F
+  double residual_rms_uT = 0.0;         // RMS(‖S(m − b)‖ − F)
+  Vec3 max_min_hard_iron_uT = Vec3::Zero();  // (max + min)/2, for comparison
+
+  Vec3 correct(const Vec3& raw) const { return soft_iron * (raw - hard_iron_uT); }
+};
+
+/// Fits the ellipsoid to a magnetometer stream (µT). Throws MeasurementError naming `source` for
+/// too few samples, too little coverage (a rotation about one axis only) or a quadric that is
+/// no ellipsoid; warns in `diagnostics` (with `source`) when some directions are missing.
+MagnetometerCalibration fit_magnetometer(const Stream& magnetometer, const MagnetometerOptions& options,
+                                         Diagnostics& diagnostics, const std::filesystem::path& source = {});
+
+}  // namespace antpose::calibration
