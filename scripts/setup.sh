@@ -12,4 +12,7 @@ DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recomme
   zlib1g-dev libpugixml-dev libgtest-dev libgmock-dev libbenchmark-dev
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release
 cmake --build build -j2
-./build/apps/antpose/antpose contact examples/contact-sample --imu-calibration examples/imu-calibration-sample
+# The main job on the bundled sample: calibrate the phone's magnetometer from its tumble
+# recording, then measure the antenna plate in contact mode.
+./build/apps/antpose/antpose calibrate imu examples/imu-calibration-sample --sensors mag -o build/sample-device.yaml --force
+./build/apps/antpose/antpose contact examples/contact-sample --imu-calibration build/sample-device.yaml

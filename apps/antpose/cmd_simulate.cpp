@@ -141,6 +141,7 @@ void run_simulate_imu(const SimulateOptions& o, const CLI::App& cmd) {
       if (o.duration_s && *o.duration_s < 3.0)
         throw InputError("--duration", fmt::format("{} s is too short for the tumble preset: at least 3 s", *o.duration_s));
       s.trajectory = sim::tumble(o.duration_s.value_or(30.0), 1.0, o.seed);
+      s.kind = "imu-calibration";  // a phone turned through all directions: a magnetometer calibration
     }
     if (tremor > 0.0) s.trajectory.with_tremor(tremor, 1e-5, o.seed);
     capture = sim::simulate_imu(s);
@@ -169,7 +170,7 @@ void add_simulate_command(CLI::App& app) {
   cmd->add_option("--seed", o->seed, "Random seed (the same seed gives the same capture)");
   cmd->add_option("--preset", o->preset,
                   "static-poses: 18 held poses (multi-position calibration, kind imu-calibration); "
-                  "tumble: continuous random rotations; contact: phone laid on an antenna's back plate (kind contact)")
+                  "tumble: continuous random rotations (magnetometer calibration, kind imu-calibration); contact: phone laid on an antenna's back plate (kind contact)")
       ->check(CLI::IsMember({"contact", "static-poses", "tumble"}))
       ->capture_default_str();
   cmd->add_option("--duration", o->duration_s,
