@@ -7,6 +7,7 @@
 
 #include "antpose/orientation/filters.hpp"
 #include "antpose/sim/imu_simulator.hpp"
+#include "orientation/simulated_truth.hpp"
 
 namespace antpose::orientation {
 namespace {
@@ -90,42 +91,11 @@ TEST(Params, ParsingAndRegistryErrors) {
 
 // ---- simulated ground truth ----------------------------------------------------------------
 
-struct Sim {
-  sim::ImuSimulation sim;
-  Capture capture;
-};
+using test::errors;
+using test::ErrorStats;
+using test::Sim;
 
-Sim simulate(sim::Trajectory trajectory, sim::PhoneModel phone = sim::PhoneModel::ideal(),
-             std::vector<sim::MagneticDisturbance> disturbances = {}) {
-  Sim s;
-  s.sim.trajectory = std::move(trajectory);
-  s.sim.phone = std::move(phone);
-  s.sim.disturbances = std::move(disturbances);
-  s.sim.seed = 11;
-  s.capture = sim::simulate_imu(s.sim);
-  return s;
-}
-
-struct ErrorStats {
-  double rms_deg = 0.0, max_deg = 0.0;
-  bool finite = true;
-};
-
-// Angle between track and simulated truth over track samples in [t0, t1].
-ErrorStats errors(const OrientationTrack& track, const sim::Trajectory& truth, double t0, double t1) {
-  ErrorStats e;
-  double sum = 0.0;
-  std::size_t n = 0;
-  for (std::size_t i = 0; i < track.size(); ++i) {
-    if (!track.q_world_device[i].coeffs().allFinite()) e.finite = false;
-    if (track.t[i] < t0 || track.t[i] > t1) continue;
-    const double a =
-        rad2deg(rotation_distance(track.q_world_device[i].toRotationMatrix(), truth.R_world_device(track.t[i])));
-    sum += a * a, e.max_deg = std::max(e.max_deg, a), ++n;
-  }
-  e.rms_deg = n ? std::sqrt(sum / static_cast<double>(n)) : 0.0;
-  return e;
-}
+using test::simulate;
 
 TEST(Estimators, IdealDataNearZeroError) {
   const Sim s = simulate(sim::random_rotations(6, 2.0, 2.0, 21));

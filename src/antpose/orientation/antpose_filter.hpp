@@ -40,6 +40,10 @@ struct AntposeFilterParams {
   double tau_acc_s = 3.0;   // inclination low-pass time constant
   double tau_mag_s = 9.0;   // heading correction time constant
   bool use_magnetometer = true;
+  // false: a gyroscope sample is the mean rate over the interval before it (VQF's convention;
+  // BROAD is scored best so); true: samples are instantaneous rates and the step integrates the
+  // trapezoidal mean of consecutive samples (simulated and many phone streams).
+  bool gyro_trapezoid = false;
   // bias estimation
   bool motion_bias = true;
   bool rest_bias = true;
@@ -80,6 +84,10 @@ class AntposeFilter final : public GyroDrivenFilter {
   AntposeFilter(const AntposeFilterParams& params, double Ts);
   void reset(const Quat& q_world_device) override;
   void update(double dt, const Vec3& gyro, const Vec3* acc, const Vec3* mag) override;
+  /// As update, with the age (s, ≥ 0) of the held accelerometer / magnetometer samples: they
+  /// are carried to the gyroscope instant by the rotation since (v ← v − age ω × v), so
+  /// asynchronous streams do not tilt the estimate while the device turns.
+  void update(double dt, const Vec3& gyro, const Vec3* acc, double acc_age, const Vec3* mag, double mag_age);
   Quat q_world_device() const override;
   std::optional<Mat3> covariance() const override;
 
@@ -91,6 +99,7 @@ class AntposeFilter final : public GyroDrivenFilter {
   double mag_reference_norm() const { return ref_norm_; }
   double mag_reference_dip() const { return ref_dip_; }
   Vec3 gyro_bias() const { return bias_; }  // rad/s, device frame
+  const AntposeFilterParams& params() const { return p_; }
   double bias_sigma() const;                // rad/s, RMS over axes
   bool at_rest() const { return rest_; }
   bool mag_disturbed() const { return mag_disturbed_; }
@@ -152,7 +161,13 @@ class AntposeFilter final : public GyroDrivenFilter {
   std::size_t nonfinite_ = 0;
 };
 
-/// Registry wrapper: runs AntposeFilter with run_gyro_driven from initial_attitude; warns when
+/// Runs the filter over `data` from q0 like run_gyro_driven (same hold and gap rules), but
+/// passes the age of the held accelerometer and magnetometer samples and, with
+/// params().gyro_trapezoid, integrates the trapezoidal mean of consecutive gyroscope samples.
+OrientationTrack run_antpose_filter(AntposeFilter& filter, const ImuData& data, const Quat& q0_world_device,
+                                   const GyroDrivenOptions& options = {});
+
+/// Registry wrapper: runs AntposeFilter with run_antpose_filter from initial_attitude; warns when
 /// the heading correction was suspended for magnetic disturbances or inputs were not finite.
 class AntposeEstimator final : public OrientationEstimator {
  public:

@@ -9,9 +9,9 @@
 namespace antpose::orientation {
 namespace {
 
-// `shift`: the value of sample i is taken from the sample after it in forward time. A gyroscope
-// sample at t_k is the rate over (t_{k-1}, t_k]; in reversed time that interval ends at −t_{k-1},
-// so the reversed sample at −t_{k-1} must carry −ω_k, or the backward pass lags by one sample.
+// `shift` (interval-mean gyroscope samples): the sample at t_k is the rate over (t_{k-1}, t_k],
+// an interval that in reversed time ends at −t_{k-1}, so the reversed sample there carries −ω_k;
+// otherwise the backward pass lags by one sample.
 SensorSeries reversed(const SensorSeries& s, double sign, bool shift) {
   SensorSeries r;
   r.t.resize(s.size());
@@ -19,8 +19,7 @@ SensorSeries reversed(const SensorSeries& s, double sign, bool shift) {
   const std::size_t n = s.size();
   for (std::size_t i = 0; i < n; ++i) {
     r.t[i] = -s.t[n - 1 - i];
-    const std::size_t src = (shift && i > 0) ? n - i : n - 1 - i;
-    r.v[i] = sign * s.v[src];
+    r.v[i] = sign * s.v[(shift && i > 0) ? n - i : n - 1 - i];
   }
   return r;
 }
@@ -58,9 +57,9 @@ double fused_var(double a, double b) {
 
 }  // namespace
 
-ImuData time_reversed(const ImuData& data) {
+ImuData time_reversed(const ImuData& data, bool interval_mean_gyro) {
   ImuData r;
-  r.gyroscope = reversed(data.gyroscope, -1.0, true);
+  r.gyroscope = reversed(data.gyroscope, -1.0, interval_mean_gyro);
   r.accelerometer = reversed(data.accelerometer, 1.0, false);
   r.magnetometer = reversed(data.magnetometer, 1.0, false);
   r.source = data.source;
@@ -102,13 +101,13 @@ OrientationTrack AntposeSmoother::estimate(const ImuData& data, Diagnostics& dia
   if (!(Ts > 0.0)) throw MeasurementError("antpose-smoother: the gyroscope has no usable sample interval");
 
   AntposeFilter fwd(p_, Ts);
-  const OrientationTrack forward = run_gyro_driven(fwd, data, initial_attitude(data));
+  const OrientationTrack forward = run_antpose_filter(fwd, data, initial_attitude(data));
 
-  const ImuData rev = time_reversed(data);
+  const ImuData rev = time_reversed(data, !p_.gyro_trapezoid);
   AntposeFilter bwd(p_, Ts);
   if (fwd.mag_reference_norm() > 0.0) bwd.set_initial_mag_reference(fwd.mag_reference_norm(), fwd.mag_reference_dip());
   bwd.set_initial_bias(-fwd.gyro_bias(), std::max(fwd.bias_sigma(), p_.bias_sigma_motion));
-  const OrientationTrack backward = run_gyro_driven(bwd, rev, initial_attitude(rev));
+  const OrientationTrack backward = run_antpose_filter(bwd, rev, initial_attitude(rev));
 
   OrientationTrack track = fuse_forward_backward(forward, backward, p_.use_magnetometer);
   track.method = name();

@@ -3,7 +3,9 @@
 // and the two estimates are fused per gyroscope sample.
 //
 // Backward pass: time t' = −t, samples in reverse order, gyroscope negated (the device turns
-// the other way in reversed time), accelerometer and magnetometer unchanged. It starts from the
+// the other way in reversed time) and, for interval-mean gyroscope samples (the default, see
+// AntposeFilterParams::gyro_trapezoid), shifted by one sample so that each still covers its own
+// interval; accelerometer and magnetometer unchanged. It starts from the
 // forward pass's final gyroscope bias (negated), the way offline VQF (Laidig & Seel, Information
 // Fusion 91, 2023, §5) reuses information from the other time direction; its error behaves like
 // an anti-causal low-pass of the sensor errors, the forward one like a causal one, so their
@@ -24,8 +26,9 @@
 
 namespace antpose::orientation {
 
-/// `data` in reversed time (see the file comment); source kept.
-ImuData time_reversed(const ImuData& data);
+/// `data` in reversed time (see the file comment); source kept. `interval_mean_gyro`: shift the
+/// gyroscope by one sample (interval-mean samples).
+ImuData time_reversed(const ImuData& data, bool interval_mean_gyro);
 
 /// Fuses a forward track and the backward track of time_reversed data (same gyroscope samples,
 /// reverse order, both with covariances) as the file comment says. std::invalid_argument when
