@@ -65,7 +65,7 @@ TEST(AntposeFilter, LargeGyroscopeBiasEstimated) {
   AntposeFilterParams params;
   params.gyro_trapezoid = true;  // the simulator samples instantaneous rates
   AntposeFilter filter(params, data.gyroscope.median_interval());
-  const auto track = run_antpose_filter(filter, data, initial_attitude(data));
+  const auto track = run_gyro_driven(filter, data, initial_attitude(data), run_options(filter.params()));
   EXPECT_LT((filter.gyro_bias() - bias).norm(), deg2rad(0.1));
   // Before rest is detected (1.5 s) the bias integrates freely; tilt then heading re-converge.
   EXPECT_LT(errors(track, s.sim.trajectory, 0.0, end).max_deg, 25.0);

@@ -83,11 +83,11 @@ void AntposeFilter::reset(const Quat& q_world_device) {
 double AntposeFilter::bias_sigma() const { return std::sqrt(std::max(P_.trace(), 0.0) / 3.0); }
 
 void AntposeFilter::update(double dt, const Vec3& gyro, const Vec3* acc, const Vec3* mag) {
-  update(dt, gyro, acc, 0.0, mag, 0.0);
+  update_with_ages(dt, gyro, acc, 0.0, mag, 0.0);
 }
 
-void AntposeFilter::update(double dt, const Vec3& gyro, const Vec3* acc_in, double acc_age, const Vec3* mag_in,
-                           double mag_age) {
+void AntposeFilter::update_with_ages(double dt, const Vec3& gyro, const Vec3* acc_in, double acc_age, const Vec3* mag_in,
+                                     double mag_age) {
   if (!(dt > 0.0) || !std::isfinite(dt)) dt = Ts_;
   const Vec3* acc = acc_in;
   const Vec3* mag = mag_in;
@@ -290,55 +290,13 @@ std::optional<Mat3> AntposeFilter::covariance() const {
   return c;
 }
 
-OrientationTrack run_antpose_filter(AntposeFilter& filter, const ImuData& data, const Quat& q0,
-                                   const GyroDrivenOptions& options) {
-  const double gyro_dt = data.gyroscope.median_interval();
-  auto hold_for = [&](const SensorSeries& s) {
-    return options.max_hold_s > 0.0 ? options.max_hold_s : std::max(0.02, 5.0 * s.median_interval());
-  };
-  const double hold_acc = hold_for(data.accelerometer), hold_mag = hold_for(data.magnetometer);
-  const double gap = options.gap_factor * gyro_dt;
-  OrientationTrack track;
-  track.t.reserve(data.gyroscope.size());
-  track.q_world_device.reserve(data.gyroscope.size());
-  track.covariance.reserve(data.gyroscope.size());
-  filter.reset(q0);
-  const Vec3* acc = nullptr;
-  const Vec3* mag = nullptr;
-  double t_acc = -std::numeric_limits<double>::infinity(), t_mag = t_acc;
-  const auto& A = data.accelerometer;
-  const auto& M = data.magnetometer;
-  const auto& G = data.gyroscope;
-  std::size_t ia = 0, im = 0;
-  const bool trapezoid = filter.params().gyro_trapezoid;
-  for (std::size_t ig = 0; ig < G.size(); ++ig) {
-    const double t = G.t[ig];
-    while (ia < A.size() && A.t[ia] <= t) acc = &A.v[ia], t_acc = A.t[ia], ++ia;
-    while (im < M.size() && M.t[im] <= t) mag = &M.v[im], t_mag = M.t[im], ++im;
-    double dt = ig == 0 ? gyro_dt : t - G.t[ig - 1];
-    // Trapezoid over a regular step; after a gap (not integrated) or on the first sample, the sample itself.
-    const bool regular = ig > 0 && dt > 0.0 && dt <= gap;
-    if (!regular) dt = gyro_dt;
-    const Vec3 w = trapezoid && regular && G.v[ig - 1].allFinite() ? Vec3(0.5 * (G.v[ig] + G.v[ig - 1])) : G.v[ig];
-    const double age_a = t - t_acc, age_m = t - t_mag;
-    filter.update(dt, w, (acc && age_a <= hold_acc) ? acc : nullptr, age_a, (mag && age_m <= hold_mag) ? mag : nullptr,
-                  age_m);
-    track.t.push_back(t);
-    Quat q = filter.q_world_device();
-    if (!track.q_world_device.empty() && q.coeffs().dot(track.q_world_device.back().coeffs()) < 0.0) q.coeffs() *= -1.0;
-    track.q_world_device.push_back(q);
-    track.covariance.push_back(*filter.covariance());
-  }
-  return track;
-}
-
 OrientationTrack AntposeEstimator::estimate(const ImuData& data, Diagnostics& diagnostics) const {
   if (p_.use_magnetometer && !data.has_magnetometer())
     throw MeasurementError("antpose: the capture has no magnetometer; use mag=0 for the 6-D filter (heading then drifts)");
   const double Ts = data.gyroscope.median_interval();
   if (!(Ts > 0.0)) throw MeasurementError("antpose: the gyroscope has no usable sample interval");
   AntposeFilter filter(p_, Ts);
-  OrientationTrack track = run_antpose_filter(filter, data, initial_attitude(data));
+  OrientationTrack track = run_gyro_driven(filter, data, initial_attitude(data), run_options(p_));
   track.method = name();
   if (filter.rejected_s() > 0.0)
     diagnostics.warn(data.source / "sensors",

@@ -87,7 +87,8 @@ class AntposeFilter final : public GyroDrivenFilter {
   /// As update, with the age (s, ≥ 0) of the held accelerometer / magnetometer samples: they
   /// are carried to the gyroscope instant by the rotation since (v ← v − age ω × v), so
   /// asynchronous streams do not tilt the estimate while the device turns.
-  void update(double dt, const Vec3& gyro, const Vec3* acc, double acc_age, const Vec3* mag, double mag_age);
+  void update_with_ages(double dt, const Vec3& gyro, const Vec3* acc, double acc_age, const Vec3* mag,
+                        double mag_age) override;
   Quat q_world_device() const override;
   std::optional<Mat3> covariance() const override;
 
@@ -161,13 +162,14 @@ class AntposeFilter final : public GyroDrivenFilter {
   std::size_t nonfinite_ = 0;
 };
 
-/// Runs the filter over `data` from q0 like run_gyro_driven (same hold and gap rules), but
-/// passes the age of the held accelerometer and magnetometer samples and, with
-/// params().gyro_trapezoid, integrates the trapezoidal mean of consecutive gyroscope samples.
-OrientationTrack run_antpose_filter(AntposeFilter& filter, const ImuData& data, const Quat& q0_world_device,
-                                   const GyroDrivenOptions& options = {});
+/// run_gyro_driven options for this filter (the gyroscope sample convention of its params).
+inline GyroDrivenOptions run_options(const AntposeFilterParams& params) {
+  GyroDrivenOptions options;
+  options.gyro_trapezoid = params.gyro_trapezoid;
+  return options;
+}
 
-/// Registry wrapper: runs AntposeFilter with run_antpose_filter from initial_attitude; warns when
+/// Registry wrapper: runs AntposeFilter with run_gyro_driven from initial_attitude; warns when
 /// the heading correction was suspended for magnetic disturbances or inputs were not finite.
 class AntposeEstimator final : public OrientationEstimator {
  public:

@@ -257,7 +257,6 @@ OrientationTrack run_gyro_driven(GyroDrivenFilter& filter, const ImuData& data, 
   const Vec3* acc = nullptr;
   const Vec3* mag = nullptr;
   double t_acc = -std::numeric_limits<double>::infinity(), t_mag = t_acc;
-  double t_prev = std::numeric_limits<double>::quiet_NaN();
 
   // The three-way merge inline (no event vector): this loop is the hot path of every filter.
   const auto& A = data.accelerometer;
@@ -268,12 +267,14 @@ OrientationTrack run_gyro_driven(GyroDrivenFilter& filter, const ImuData& data, 
     const double t = G.t[ig];
     while (ia < A.size() && A.t[ia] <= t) acc = &A.v[ia], t_acc = A.t[ia], ++ia;
     while (im < M.size() && M.t[im] <= t) mag = &M.v[im], t_mag = M.t[im], ++im;
-    double dt = std::isnan(t_prev) ? gyro_dt : t - t_prev;
-    if (dt > gap || !(dt > 0.0)) dt = gyro_dt;
-    t_prev = t;
-    const Vec3* a = (acc && t - t_acc <= hold_acc) ? acc : nullptr;
-    const Vec3* m = (mag && t - t_mag <= hold_mag) ? mag : nullptr;
-    filter.update(dt, G.v[ig], a, m);
+    double dt = ig == 0 ? gyro_dt : t - G.t[ig - 1];
+    const bool regular = ig > 0 && dt > 0.0 && dt <= gap;
+    if (!regular) dt = gyro_dt;  // a gap is not integrated: the corrections pull the filter back
+    const Vec3 w = options.gyro_trapezoid && regular && G.v[ig - 1].allFinite() ? Vec3(0.5 * (G.v[ig] + G.v[ig - 1]))
+                                                                               : G.v[ig];
+    const double age_a = t - t_acc, age_m = t - t_mag;
+    filter.update_with_ages(dt, w, (acc && age_a <= hold_acc) ? acc : nullptr, age_a,
+                            (mag && age_m <= hold_mag) ? mag : nullptr, age_m);
     track.push_back(t, filter.q_world_device(), filter.covariance());
   }
   return track;

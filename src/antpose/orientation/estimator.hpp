@@ -153,6 +153,13 @@ class GyroDrivenFilter {
   /// Predict over dt (s) with the gyroscope rate (rad/s, device frame), then correct with the
   /// specific force (m/s²) and field (µT) when not null.
   virtual void update(double dt, const Vec3& gyro, const Vec3* acc, const Vec3* mag) = 0;
+  /// The same, told how old (s) the held accelerometer and magnetometer samples are. Filters
+  /// that use the age (e.g. to rotate a stale sample forward) override this; others ignore it.
+  virtual void update_with_ages(double dt, const Vec3& gyro, const Vec3* acc, double acc_age, const Vec3* mag,
+                                double mag_age) {
+    (void)acc_age, (void)mag_age;
+    update(dt, gyro, acc, mag);
+  }
   virtual Quat q_world_device() const = 0;  // enu-magnetic
   /// Optional covariance of the current estimate (see file comment).
   virtual std::optional<Mat3> covariance() const { return std::nullopt; }
@@ -161,6 +168,8 @@ class GyroDrivenFilter {
 struct GyroDrivenOptions {
   double max_hold_s = 0.0;    // 0: 5 × the stream's median interval (at least 20 ms)
   double gap_factor = 10.0;   // gyroscope interval > gap_factor × median: not integrated
+  bool gyro_trapezoid = false;  // samples are instantaneous rates: integrate the mean of two
+                                // consecutive samples (false: each sample is the interval's mean rate)
 };
 
 /// Runs `filter` over `data` as the file comment says, starting from q0_world_device (applied with

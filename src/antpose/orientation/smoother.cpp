@@ -101,13 +101,13 @@ OrientationTrack AntposeSmoother::estimate(const ImuData& data, Diagnostics& dia
   if (!(Ts > 0.0)) throw MeasurementError("antpose-smoother: the gyroscope has no usable sample interval");
 
   AntposeFilter fwd(p_, Ts);
-  const OrientationTrack forward = run_antpose_filter(fwd, data, initial_attitude(data));
+  const OrientationTrack forward = run_gyro_driven(fwd, data, initial_attitude(data), run_options(fwd.params()));
 
   const ImuData rev = time_reversed(data, !p_.gyro_trapezoid);
   AntposeFilter bwd(p_, Ts);
   if (fwd.mag_reference_norm() > 0.0) bwd.set_initial_mag_reference(fwd.mag_reference_norm(), fwd.mag_reference_dip());
   bwd.set_initial_bias(-fwd.gyro_bias(), std::max(fwd.bias_sigma(), p_.bias_sigma_motion));
-  const OrientationTrack backward = run_antpose_filter(bwd, rev, initial_attitude(rev));
+  const OrientationTrack backward = run_gyro_driven(bwd, rev, initial_attitude(rev), run_options(bwd.params()));
 
   OrientationTrack track = fuse_forward_backward(forward, backward, p_.use_magnetometer);
   track.method = name();
