@@ -1,4 +1,5 @@
 #include "antpose/calibration/accelerometer.hpp"
+#include "antpose/calibration/least_squares.hpp"
 
 #include <cmath>
 
@@ -93,15 +94,7 @@ AccelerometerCalibration fit_accelerometer_full(const std::vector<Vec3>& means, 
   ceres::Problem problem;
   for (const auto& y : means)
     problem.AddResidualBlock(new ceres::AutoDiffCostFunction<GravityResidual, 1, 9>(new GravityResidual(y, g)), nullptr, p);
-  ceres::Solver::Options options;
-  options.linear_solver_type = ceres::DENSE_QR;
-  options.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
-  options.max_num_iterations = 200;
-  options.function_tolerance = 1e-14;
-  options.parameter_tolerance = 1e-14;
-  options.logging_type = ceres::SILENT;
-  ceres::Solver::Summary summary;
-  ceres::Solve(options, &problem, &summary);
+  const ceres::Solver::Summary summary = solve_levenberg_marquardt(problem, 200, 1e-14);
   if (!summary.IsSolutionUsable())
     throw MeasurementError(fmt::format("{}{}accelerometer 9-parameter fit failed: {}", source, source.empty() ? "" : ": ",
                                        summary.message));

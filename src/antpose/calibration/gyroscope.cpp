@@ -1,4 +1,5 @@
 #include "antpose/calibration/gyroscope.hpp"
+#include "antpose/calibration/least_squares.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -177,15 +178,7 @@ GyroscopeCalibration fit_gyroscope(const Stream& gyro, const std::vector<StaticF
                                  new GravityDirectionResidual(&tr, options.fit_misalignment)),
                              nullptr, p);
   if (!options.fit_misalignment) problem.SetManifold(p, new ceres::SubsetManifold(9, {0, 1, 2, 3, 4, 5}));
-  ceres::Solver::Options so;
-  so.linear_solver_type = ceres::DENSE_QR;
-  so.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
-  so.max_num_iterations = 100;
-  so.function_tolerance = 1e-12;
-  so.parameter_tolerance = 1e-12;
-  so.logging_type = ceres::SILENT;
-  ceres::Solver::Summary summary;
-  ceres::Solve(so, &problem, &summary);
+  const ceres::Solver::Summary summary = solve_levenberg_marquardt(problem, 100, 1e-12);
   if (!summary.IsSolutionUsable())
     throw MeasurementError(prefix(source) + "gyroscope fit failed: " + summary.message);
   c.misalignment << 1, p[0], p[1], p[2], 1, p[3], p[4], p[5], 1;

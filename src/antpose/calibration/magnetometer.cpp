@@ -1,4 +1,5 @@
 #include "antpose/calibration/magnetometer.hpp"
+#include "antpose/calibration/least_squares.hpp"
 
 #include <array>
 #include <cmath>
@@ -158,12 +159,7 @@ MagnetometerCalibration fit_magnetometer(const Stream& stream, const Magnetomete
     for (const auto& x : m)
       problem.AddResidualBlock(new ceres::AutoDiffCostFunction<EllipsoidResidual, 1, 3, 6, 1>(new EllipsoidResidual(x)),
                                nullptr, b, s, &f);
-    ceres::Solver::Options so;
-    so.linear_solver_type = ceres::DENSE_QR;
-    so.max_num_iterations = 50;
-    so.logging_type = ceres::SILENT;
-    ceres::Solver::Summary summary;
-    ceres::Solve(so, &problem, &summary);
+    const ceres::Solver::Summary summary = solve_levenberg_marquardt(problem, 50, 1e-10);
     Mat3 S;
     S << s[0], s[1], s[2], s[1], s[3], s[4], s[2], s[4], s[5];
     const double det = S.determinant();

@@ -115,6 +115,45 @@ Quat MadgwickBroadFilter::q_world_device() const {
                             static_cast<double>(q3_));
 }
 
+namespace {
+
+// The steps both reference updates share, in MadgwickAHRS.cpp's float operation order so that
+// the benchmark numbers are reproduced to the last digit.
+
+// q̇ = ½ q ⊗ (0, ω)
+void rate_of_change(float q0, float q1, float q2, float q3, float gx, float gy, float gz, float& d1, float& d2,
+                    float& d3, float& d4) {
+  d1 = 0.5f * (-q1 * gx - q2 * gy - q3 * gz);
+  d2 = 0.5f * (q0 * gx + q2 * gz - q3 * gy);
+  d3 = 0.5f * (q0 * gy - q1 * gz + q3 * gx);
+  d4 = 0.5f * (q0 * gz + q1 * gy - q2 * gx);
+}
+
+// q̇ −= β s/|s| (the normalised gradient step)
+void descend(float beta, float s0, float s1, float s2, float s3, float& d1, float& d2, float& d3, float& d4) {
+  const float recipNorm = 1.0f / std::sqrt(s0 * s0 + s1 * s1 + s2 * s2 + s3 * s3);
+  d1 -= beta * (s0 * recipNorm);
+  d2 -= beta * (s1 * recipNorm);
+  d3 -= beta * (s2 * recipNorm);
+  d4 -= beta * (s3 * recipNorm);
+}
+
+// q ← normalise(q + q̇ / f)
+void integrate(float sample_freq, float q0, float q1, float q2, float q3, float d1, float d2, float d3, float d4,
+               float& o0, float& o1, float& o2, float& o3) {
+  q0 += d1 * (1.0f / sample_freq);
+  q1 += d2 * (1.0f / sample_freq);
+  q2 += d3 * (1.0f / sample_freq);
+  q3 += d4 * (1.0f / sample_freq);
+  const float recipNorm = 1.0f / std::sqrt(q0 * q0 + q1 * q1 + q2 * q2 + q3 * q3);
+  o0 = q0 * recipNorm;
+  o1 = q1 * recipNorm;
+  o2 = q2 * recipNorm;
+  o3 = q3 * recipNorm;
+}
+
+}  // namespace
+
 // The statement order and the float arithmetic follow MadgwickAHRS.cpp (BROAD example_code),
 // including the variables _2bx, _2bz that hold bx, bz (the defect the benchmark reproduces).
 void MadgwickBroadFilter::update(double /*dt*/, const Vec3& gyro, const Vec3* acc, const Vec3* mag) {
@@ -128,10 +167,8 @@ void MadgwickBroadFilter::update(double /*dt*/, const Vec3& gyro, const Vec3* ac
     return;
   }
   float q0 = q0_, q1 = q1_, q2 = q2_, q3 = q3_;
-  float qDot1 = 0.5f * (-q1 * gx - q2 * gy - q3 * gz);
-  float qDot2 = 0.5f * (q0 * gx + q2 * gz - q3 * gy);
-  float qDot3 = 0.5f * (q0 * gy - q1 * gz + q3 * gx);
-  float qDot4 = 0.5f * (q0 * gz + q1 * gy - q2 * gx);
+  float qDot1, qDot2, qDot3, qDot4;
+  rate_of_change(q0, q1, q2, q3, gx, gy, gz, qDot1, qDot2, qDot3, qDot4);
   if (!(ax == 0.0f && ay == 0.0f && az == 0.0f)) {
     float recipNorm = 1.0f / std::sqrt(ax * ax + ay * ay + az * az);
     ax *= recipNorm;
@@ -165,33 +202,15 @@ void MadgwickBroadFilter::update(double /*dt*/, const Vec3& gyro, const Vec3* ac
     float s2 = -_2q0 * ex + _2q3 * ey - 4.0f * q2 * ez + (-_4bx * q2 - _2bz * q0) * mfx + (_2bx * q1 + _2bz * q3) * mfy +
                (_2bx * q0 - _4bz * q2) * mfz;
     float s3 = _2q1 * ex + _2q2 * ey + (-_4bx * q3 + _2bz * q1) * mfx + (-_2bx * q0 + _2bz * q2) * mfy + _2bx * q1 * mfz;
-    recipNorm = 1.0f / std::sqrt(s0 * s0 + s1 * s1 + s2 * s2 + s3 * s3);
-    s0 *= recipNorm;
-    s1 *= recipNorm;
-    s2 *= recipNorm;
-    s3 *= recipNorm;
-    qDot1 -= beta_ * s0;
-    qDot2 -= beta_ * s1;
-    qDot3 -= beta_ * s2;
-    qDot4 -= beta_ * s3;
+    descend(beta_, s0, s1, s2, s3, qDot1, qDot2, qDot3, qDot4);
   }
-  q0 += qDot1 * (1.0f / sample_freq_);
-  q1 += qDot2 * (1.0f / sample_freq_);
-  q2 += qDot3 * (1.0f / sample_freq_);
-  q3 += qDot4 * (1.0f / sample_freq_);
-  const float recipNorm = 1.0f / std::sqrt(q0 * q0 + q1 * q1 + q2 * q2 + q3 * q3);
-  q0_ = q0 * recipNorm;
-  q1_ = q1 * recipNorm;
-  q2_ = q2 * recipNorm;
-  q3_ = q3 * recipNorm;
+  integrate(sample_freq_, q0, q1, q2, q3, qDot1, qDot2, qDot3, qDot4, q0_, q1_, q2_, q3_);
 }
 
 void MadgwickBroadFilter::update_imu(float gx, float gy, float gz, float ax, float ay, float az) {
   float q0 = q0_, q1 = q1_, q2 = q2_, q3 = q3_;
-  float qDot1 = 0.5f * (-q1 * gx - q2 * gy - q3 * gz);
-  float qDot2 = 0.5f * (q0 * gx + q2 * gz - q3 * gy);
-  float qDot3 = 0.5f * (q0 * gy - q1 * gz + q3 * gx);
-  float qDot4 = 0.5f * (q0 * gz + q1 * gy - q2 * gx);
+  float qDot1, qDot2, qDot3, qDot4;
+  rate_of_change(q0, q1, q2, q3, gx, gy, gz, qDot1, qDot2, qDot3, qDot4);
   if (!(ax == 0.0f && ay == 0.0f && az == 0.0f)) {
     float recipNorm = 1.0f / std::sqrt(ax * ax + ay * ay + az * az);
     ax *= recipNorm;
@@ -204,25 +223,9 @@ void MadgwickBroadFilter::update_imu(float gx, float gy, float gz, float ax, flo
     float s1 = _4q1 * q3q3 - _2q3 * ax + 4.0f * q0q0 * q1 - _2q0 * ay - _4q1 + _8q1 * q1q1 + _8q1 * q2q2 + _4q1 * az;
     float s2 = 4.0f * q0q0 * q2 + _2q0 * ax + _4q2 * q3q3 - _2q3 * ay - _4q2 + _8q2 * q1q1 + _8q2 * q2q2 + _4q2 * az;
     float s3 = 4.0f * q1q1 * q3 - _2q1 * ax + 4.0f * q2q2 * q3 - _2q2 * ay;
-    recipNorm = 1.0f / std::sqrt(s0 * s0 + s1 * s1 + s2 * s2 + s3 * s3);
-    s0 *= recipNorm;
-    s1 *= recipNorm;
-    s2 *= recipNorm;
-    s3 *= recipNorm;
-    qDot1 -= beta_ * s0;
-    qDot2 -= beta_ * s1;
-    qDot3 -= beta_ * s2;
-    qDot4 -= beta_ * s3;
+    descend(beta_, s0, s1, s2, s3, qDot1, qDot2, qDot3, qDot4);
   }
-  q0 += qDot1 * (1.0f / sample_freq_);
-  q1 += qDot2 * (1.0f / sample_freq_);
-  q2 += qDot3 * (1.0f / sample_freq_);
-  q3 += qDot4 * (1.0f / sample_freq_);
-  const float recipNorm = 1.0f / std::sqrt(q0 * q0 + q1 * q1 + q2 * q2 + q3 * q3);
-  q0_ = q0 * recipNorm;
-  q1_ = q1 * recipNorm;
-  q2_ = q2 * recipNorm;
-  q3_ = q3 * recipNorm;
+  integrate(sample_freq_, q0, q1, q2, q3, qDot1, qDot2, qDot3, qDot4, q0_, q1_, q2_, q3_);
 }
 
 Quat broad_initial_state(const Vec3& acc, const Vec3& mag) {
