@@ -109,19 +109,8 @@ AccelerometerCalibration fit_accelerometer_full(const std::vector<Vec3>& means, 
   c.bias = Vec3(p[6], p[7], p[8]);
   c.rms_before = start.rms_before;
   std::tie(c.rms_after, c.max_after) = gravity_residual(c, means);
-  if (means.size() > 9) {
-    ceres::Covariance::Options co;
-    co.algorithm_type = ceres::DENSE_SVD;
-    co.null_space_rank = -1;
-    ceres::Covariance covariance(co);
-    const std::vector<std::pair<const double*, const double*>> blocks = {{p, p}};
-    if (covariance.Compute(blocks, &problem)) {
-      double cov[81];
-      covariance.GetCovarianceBlock(p, p, cov);
-      const double s2 = 2.0 * summary.final_cost / static_cast<double>(means.size() - 9);
-      for (int i = 0; i < 9; ++i) c.sigma[i] = std::sqrt(std::max(0.0, cov[i * 9 + i] * s2));
-    }
-  }
+  if (means.size() > 9)
+    parameter_sigmas(problem, p, summary.final_cost, static_cast<double>(means.size() - 9), c.sigma);
   return c;
 }
 

@@ -186,19 +186,7 @@ GyroscopeCalibration fit_gyroscope(const Stream& gyro, const std::vector<StaticF
   c.rms_after = rms_angle(trs, c.correction());
   const std::size_t dof = 2 * trs.size();  // each residual is a unit-vector difference: 2 degrees of freedom
   const std::size_t params = options.fit_misalignment ? 9 : 3;
-  if (dof > params) {
-    ceres::Covariance::Options co;
-    co.algorithm_type = ceres::DENSE_SVD;
-    co.null_space_rank = -1;
-    ceres::Covariance covariance(co);
-    const std::vector<std::pair<const double*, const double*>> blocks = {{p, p}};
-    if (covariance.Compute(blocks, &problem)) {
-      double cov[81];
-      covariance.GetCovarianceBlock(p, p, cov);
-      const double s2 = 2.0 * summary.final_cost / static_cast<double>(dof - params);
-      for (int i = 0; i < 9; ++i) c.sigma[i] = std::sqrt(std::max(0.0, cov[i * 9 + i] * s2));
-    }
-  }
+  if (dof > params) parameter_sigmas(problem, p, summary.final_cost, static_cast<double>(dof - params), c.sigma);
   return c;
 }
 
