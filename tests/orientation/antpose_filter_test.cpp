@@ -79,14 +79,7 @@ TEST(AntposeFilter, LargeGyroscopeBiasEstimated) {
 TEST(AntposeFilter, OneSecondGyroscopeGap) {
   Sim s = simulate(sim::random_rotations(4, 3.0, 2.0, 9).hold(15.0), sim::PhoneModel::typical());
   const Sim baseline = s;
-  Stream& g = s.capture.streams.at("gyroscope");
-  Stream cut = g;
-  cut.t.clear();
-  std::vector<Eigen::Index> keep;
-  for (std::size_t i = 0; i < g.size(); ++i)
-    if (g.t[i] < 6.0 || g.t[i] >= 7.0) keep.push_back(static_cast<Eigen::Index>(i)), cut.t.push_back(g.t[i]);
-  cut.values = g.values(keep, Eigen::all);
-  g = cut;
+  test::cut_stream(s.capture, "gyroscope", 6.0, 7.0);
   Diagnostics diag;
   const ImuData data = imu_data_from_capture(s.capture, diag);
   EXPECT_TRUE(diag.mentions("gap(s) in the gyroscope stream"));

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -49,6 +50,17 @@ inline ErrorStats errors(const OrientationTrack& track, const sim::Trajectory& t
   }
   e.rms_deg = n ? std::sqrt(sum / static_cast<double>(n)) : 0.0;
   return e;
+}
+
+/// Removes the samples with t in [t0, t1) from a stream (a gap).
+inline void cut_stream(Capture& capture, const std::string& name, double t0, double t1) {
+  Stream& stream = capture.streams.at(name);
+  std::vector<double> t;
+  std::vector<Eigen::Index> keep;
+  for (std::size_t i = 0; i < stream.size(); ++i)
+    if (stream.t[i] < t0 || stream.t[i] >= t1) keep.push_back(static_cast<Eigen::Index>(i)), t.push_back(stream.t[i]);
+  stream.values = Stream::Values(stream.values(keep, Eigen::all));
+  stream.t = std::move(t);
 }
 
 }  // namespace antpose::orientation::test
