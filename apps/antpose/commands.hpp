@@ -15,6 +15,11 @@ void add_simulate_command(CLI::App& app);
 void add_bench_command(CLI::App& app);
 void add_orientation_command(CLI::App& app);
 void add_calibrate_command(CLI::App& app);
+void add_device_command(CLI::App& app);
+// Sub-verbs registered by their parent verb.
+void add_calibrate_camera_command(CLI::App& calibrate);
+void add_calibrate_joint_command(CLI::App& calibrate);
+void add_simulate_capture_command(CLI::App& simulate);
 
 /// Prints each warning as "warning: <file>:<line>: <message>" on stderr.
 void print_warnings(const Diagnostics& diagnostics);

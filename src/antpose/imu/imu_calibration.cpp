@@ -6,6 +6,7 @@
 
 #include "antpose/io/csv.hpp"
 #include "antpose/io/text_file.hpp"
+#include "antpose/io/yaml_util.hpp"
 
 namespace antpose::imu {
 namespace fs = std::filesystem;
@@ -14,51 +15,16 @@ namespace {
 
 constexpr const char* kFormatName = "antpose-device";
 
-std::size_t line_of(const YAML::Node& node) {
-  return node.Mark().is_null() ? 0 : static_cast<std::size_t>(node.Mark().line) + 1;
-}
-
-std::string show(const YAML::Node& node) {
-  if (node.IsScalar()) return "'" + node.Scalar() + "'";
-  if (node.IsSequence()) return fmt::format("a list of {}", node.size());
-  if (node.IsMap()) return "a map";
-  return "empty";
-}
+using io::line_of;
+using io::show;
 
 double number(const YAML::Node& node, const fs::path& file, const std::string& key) {
-  double v = 0.0;
-  try {
-    v = node.as<double>();
-  } catch (const YAML::Exception&) {
-    throw InputError(file, line_of(node), fmt::format("{}: {} is not a number", key, show(node)));
-  }
-  if (!std::isfinite(v)) throw InputError(file, line_of(node), fmt::format("{}: {} is not a finite number", key, show(node)));
-  return v;
+  return io::yaml_number(node, file, key);
 }
-
-Vec3 vec3(const YAML::Node& node, const fs::path& file, const std::string& key) {
-  if (!node.IsSequence() || node.size() != 3)
-    throw InputError(file, line_of(node), fmt::format("{} is {}, expected a list of 3 numbers [x, y, z]", key, show(node)));
-  Vec3 v;
-  for (std::size_t k = 0; k < 3; ++k) v[static_cast<Eigen::Index>(k)] = number(node[k], file, fmt::format("{}[{}]", key, k));
-  return v;
-}
-
-Mat3 mat3(const YAML::Node& node, const fs::path& file, const std::string& key) {
-  if (!node.IsSequence() || node.size() != 3)
-    throw InputError(file, line_of(node),
-                     fmt::format("{} is {}, expected 3 rows of 3 numbers [[..], [..], [..]]", key, show(node)));
-  Mat3 M;
-  for (std::size_t r = 0; r < 3; ++r)
-    M.row(static_cast<Eigen::Index>(r)) = vec3(node[r], file, fmt::format("{}[{}]", key, r)).transpose();
-  return M;
-}
-
-const YAML::Node section(const YAML::Node& parent, const char* key, const fs::path& file, const std::string& path) {
-  const YAML::Node node = parent[key];
-  if (node && !node.IsMap())
-    throw InputError(file, line_of(node), fmt::format("'{}' is {}, expected a map", path, show(node)));
-  return node;
+Vec3 vec3(const YAML::Node& node, const fs::path& file, const std::string& key) { return io::yaml_vec3(node, file, key); }
+Mat3 mat3(const YAML::Node& node, const fs::path& file, const std::string& key) { return io::yaml_mat3(node, file, key); }
+YAML::Node section(const YAML::Node& parent, const char* key, const fs::path& file, const std::string& path) {
+  return io::yaml_section(parent, key, file, path);
 }
 
 Vec3 scale(const YAML::Node& node, const fs::path& file, const std::string& key) {
@@ -81,28 +47,14 @@ Mat3 misalignment(const YAML::Node& node, const fs::path& file, const std::strin
   return T;
 }
 
-YAML::Node flow_vector(const Vec3& v) {
-  YAML::Node n(YAML::NodeType::Sequence);
-  for (int k = 0; k < 3; ++k) n.push_back(io::format_number(v[k]));
-  n.SetStyle(YAML::EmitterStyle::Flow);
-  return n;
-}
-
-YAML::Node flow_matrix(const Mat3& M) {
-  YAML::Node n(YAML::NodeType::Sequence);
-  for (int r = 0; r < 3; ++r) n.push_back(flow_vector(M.row(r).transpose()));
-  return n;
-}
+YAML::Node flow_vector(const Vec3& v) { return io::yaml_flow_vector(v); }
+YAML::Node flow_matrix(const Mat3& M) { return io::yaml_flow_matrix(M); }
 
 }  // namespace
 
 ImuCalibration parse_imu_calibration(const std::string& text, const fs::path& file) {
   ImuCalibration c;
-  try {
-    c.document = YAML::Load(text);
-  } catch (const YAML::Exception& e) {
-    throw InputError(file, e.mark.is_null() ? 0 : static_cast<std::size_t>(e.mark.line) + 1, "not valid YAML: " + e.msg);
-  }
+  c.document = io::load_yaml(text, file);
   const YAML::Node& d = c.document;
   if (!d.IsMap()) throw InputError(file, "expected a YAML map with 'format: antpose-device' (an IMU calibration file)");
   if (!d["format"]) throw InputError(file, "no 'format' key: not an IMU calibration file (expected 'format: antpose-device')");

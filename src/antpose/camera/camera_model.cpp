@@ -1,0 +1,68 @@
+#include "antpose/camera/camera_model.hpp"
+
+#include <cmath>
+
+#include <fmt/core.h>
+
+namespace antpose::camera {
+
+Mat3 CameraIntrinsics::K() const {
+  Mat3 k;
+  k << fx, 0.0, cx, 0.0, fy, cy, 0.0, 0.0, 1.0;
+  return k;
+}
+
+bool CameraIntrinsics::has_distortion() const {
+  for (double d : distortion)
+    if (d != 0.0) return true;
+  return false;
+}
+
+Vec2 CameraIntrinsics::distort(const Vec2& xy) const {
+  const auto& [k1, k2, p1, p2, k3] = distortion;
+  const double x = xy.x(), y = xy.y();
+  const double r2 = x * x + y * y;
+  const double radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3));
+  return {x * radial + 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x),
+          y * radial + p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y};
+}
+
+Vec2 CameraIntrinsics::undistort(const Vec2& xy_d) const {
+  if (!has_distortion()) return xy_d;
+  // Fixed point x = (x_d − tangential(x)) / radial(x); converges for the monotonic part of the
+  // lens model, which is all of the image for phone lenses. Stop when the step is negligible.
+  Vec2 xy = xy_d;
+  for (int it = 0; it < 50; ++it) {
+    const Vec2 step = xy_d - distort(xy);
+    xy += step;
+    if (step.squaredNorm() < 1e-24) break;
+  }
+  return xy;
+}
+
+std::optional<Vec2> CameraIntrinsics::project(const Vec3& p) const {
+  if (!(p.z() > 0.0)) return std::nullopt;
+  const Vec2 d = distort(Vec2(p.x() / p.z(), p.y() / p.z()));
+  return Vec2(fx * d.x() + cx, fy * d.y() + cy);
+}
+
+Vec3 CameraIntrinsics::ray(const Vec2& uv) const {
+  const Vec2 xy = undistort(Vec2((uv.x() - cx) / fx, (uv.y() - cy) / fy));
+  return Vec3(xy.x(), xy.y(), 1.0).normalized();
+}
+
+std::optional<std::string> CameraIntrinsics::invalid_reason() const {
+  if (width <= 0 || height <= 0) return fmt::format("image size {}x{} px (expected positive)", width, height);
+  for (double v : {fx, fy, cx, cy})
+    if (!std::isfinite(v)) return std::string("a camera matrix entry is not a finite number");
+  for (double d : distortion)
+    if (!std::isfinite(d)) return std::string("a distortion coefficient is not a finite number");
+  if (!(fx > 0.0) || !(fy > 0.0)) return fmt::format("focal length fx={} fy={} px (expected > 0)", fx, fy);
+  if (cx < 0.0 || cx > width || cy < 0.0 || cy > height)
+    return fmt::format("principal point ({}, {}) px outside the {}x{} image", cx, cy, width, height);
+  return std::nullopt;
+}
+
+Mat3 nominal_R_device_camera() { return Vec3(1.0, -1.0, -1.0).asDiagonal(); }
+
+}  // namespace antpose::camera
