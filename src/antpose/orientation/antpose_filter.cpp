@@ -77,7 +77,7 @@ void AntposeFilter::reset(const Quat& q_world_device) {
   mag_disturbed_ = false;
   sigma_h_ = p_.use_magnetometer ? p_.heading_sigma_init : 0.0;
   sigma_i_ = p_.tilt_sigma_init;
-  nonfinite_ = 0;
+  nonfinite_ = clipped_ = 0;
 }
 
 double AntposeFilter::bias_sigma() const { return std::sqrt(std::max(P_.trace(), 0.0) / 3.0); }
@@ -109,6 +109,13 @@ void AntposeFilter::update_with_ages(double dt, const Vec3& gyro, const Vec3* ac
       q_I_device_.normalize();
     }
     update_rest(gyro, acc);
+    // At the clip level the rotation beyond the range is lost: the attitude uncertainty grows
+    // by up to the measured rate over the step.
+    if (p_.gyro_clip_rad_s > 0.0 && gyro.cwiseAbs().maxCoeff() >= p_.gyro_clip_rad_s) {
+      sigma_i_ += gyro.norm() * dt;
+      if (p_.use_magnetometer) sigma_h_ += gyro.norm() * dt;
+      ++clipped_;
+    }
   } else {
     ++nonfinite_;
   }
@@ -217,6 +224,13 @@ void AntposeFilter::update_bias() {
 void AntposeFilter::update_mag(const Vec3& mag) {
   const Vec3 m = q_E_I_ * (q_I_device_ * mag);  // 6-D earth frame
   double k = k_mag_;
+  if (p_.mag_drift_budget > 0.0 && sigma_h_ < p_.mag_long_max_sigma) {
+    // Long averaging only while the heading is known well: after the start or a clipped
+    // gyroscope the heading must re-converge at tau_mag_s.
+    const double sb = bias_sigma();
+    const double tau = sb > 0.0 ? std::clamp(p_.mag_drift_budget / sb, p_.tau_mag_s, p_.tau_mag_max_s) : p_.tau_mag_max_s;
+    k = gain(tau, Ts_);
+  }
   if (p_.mag_rejection) {
     const double norm = m.norm();
     const double dip = -std::asin(std::clamp(m.z() / norm, -1.0, 1.0));
@@ -308,10 +322,13 @@ OrientationTrack AntposeEstimator::estimate(const ImuData& data, Diagnostics& di
   return track;
 }
 
-std::vector<ParamSpec> antpose_filter_param_specs() {
+std::vector<ParamSpec> antpose_filter_param_specs(bool offline) {
   const AntposeFilterParams d;
   return {{"tau_acc", d.tau_acc_s, "inclination low-pass time constant, s"},
-          {"tau_mag", d.tau_mag_s, "heading correction time constant, s"},
+          {"tau_mag", d.tau_mag_s, "heading correction time constant, s (the shortest one when adaptive)"},
+          {"mag_drift_budget", offline ? kSmootherDriftBudgetDeg : 0.0,
+           "adaptive heading time constant: gyroscope drift allowed over it, deg (0: fixed tau_mag)"},
+          {"tau_mag_max", d.tau_mag_max_s, "longest adaptive heading time constant, s"},
           {"mag", 1.0, "1: use the magnetometer, 0: 6-D (heading drifts)"},
           {"motion_bias", 1.0, "1: estimate the gyroscope bias in motion"},
           {"rest_bias", 1.0, "1: estimate the gyroscope bias at rest"},
@@ -334,6 +351,13 @@ AntposeFilterParams antpose_filter_params(const EstimatorParams& p, const char* 
   AntposeFilterParams a;
   a.tau_acc_s = positive("tau_acc");
   a.tau_mag_s = positive("tau_mag");
+  a.mag_drift_budget = deg2rad(p.at("mag_drift_budget"));
+  if (!(a.mag_drift_budget >= 0.0))
+    throw InputError("--param", fmt::format("{}: mag_drift_budget must be >= 0 (got {})", method, p.at("mag_drift_budget")));
+  a.tau_mag_max_s = positive("tau_mag_max");
+  if (a.tau_mag_max_s < a.tau_mag_s)
+    throw InputError("--param", fmt::format("{}: tau_mag_max ({} s) must be >= tau_mag ({} s)", method, a.tau_mag_max_s,
+                                            a.tau_mag_s));
   a.use_magnetometer = flag("mag");
   a.motion_bias = flag("motion_bias");
   a.rest_bias = flag("rest_bias");

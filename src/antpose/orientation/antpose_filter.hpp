@@ -36,9 +36,21 @@
 
 namespace antpose::orientation {
 
+/// Default adaptive-heading drift budget of the offline smoother, degrees (smoother.hpp).
+inline constexpr double kSmootherDriftBudgetDeg = 3.0;
+
 struct AntposeFilterParams {
   double tau_acc_s = 3.0;   // inclination low-pass time constant
-  double tau_mag_s = 9.0;   // heading correction time constant
+  double tau_mag_s = 9.0;   // heading correction time constant (the shortest when adaptive)
+  // Adaptive heading time constant (0: off, tau_mag_s fixed): the magnetometer heading is
+  // averaged over the longest window τ in which the gyroscope's drift σ_b·τ (σ_b the bias
+  // filter's current standard deviation) stays within this budget, τ ∈ [tau_mag_s, tau_mag_max_s].
+  double mag_drift_budget = 0.0;  // rad
+  double tau_mag_max_s = 60.0;
+  double mag_long_max_sigma = deg2rad(15.0);  // rad: above this heading σ, tau_mag_s is used
+  // Gyroscope clip level (rad/s, 0: unknown). The smoother sets it from the whole log
+  // (gyro_saturation); samples at it grow the attitude σ.
+  double gyro_clip_rad_s = 0.0;
   bool use_magnetometer = true;
   // false: a gyroscope sample is the mean rate over the interval before it (VQF's convention;
   // BROAD is scored best so); true: samples are instantaneous rates and the step integrates the
@@ -49,7 +61,10 @@ struct AntposeFilterParams {
   bool rest_bias = true;
   double bias_sigma_init = deg2rad(0.5);     // rad/s
   double bias_forgetting_s = 100.0;          // process noise: (0.1°/s)² per bias_forgetting_s
-  double bias_sigma_motion = deg2rad(0.1);   // rad/s, steady-state σ from motion updates
+  // rad/s, steady-state σ from motion updates. 0.3°/s rather than VQF's tighter setting: phone
+  // logs (Tyrex) walk with linear acceleration and stream skew that a tighter motion update
+  // turns into bias (Thibaud NoDist heading 9.2° at 0.1°/s, 5.6° at 0.3°/s; BROAD unchanged).
+  double bias_sigma_motion = deg2rad(0.3);
   double bias_vertical_factor = 1e-4;        // weight of the vertical-bias pseudo-measurement
   double bias_sigma_rest = deg2rad(0.03);    // rad/s
   double bias_clip = deg2rad(8.0);           // rad/s, |b| limit (the iPhone 5 has 5.7°/s)
@@ -109,6 +124,8 @@ class AntposeFilter final : public GyroDrivenFilter {
   /// Seconds during which the heading correction was suspended for a detected disturbance.
   double rejected_s() const { return rejected_total_s_; }
   std::size_t nonfinite_inputs() const { return nonfinite_; }
+  /// Gyroscope samples at the clip level (gyro_clip_rad_s).
+  std::size_t clipped_samples() const { return clipped_; }
 
  private:
   struct Butter2 {  // second-order low-pass, direct form II transposed
@@ -159,7 +176,7 @@ class AntposeFilter final : public GyroDrivenFilter {
   double rejected_total_s_ = 0;
 
   double sigma_h_ = 0, sigma_i_ = 0;
-  std::size_t nonfinite_ = 0;
+  std::size_t nonfinite_ = 0, clipped_ = 0;
 };
 
 /// run_gyro_driven options for this filter (the gyroscope sample convention of its params).
@@ -183,8 +200,9 @@ class AntposeEstimator final : public OrientationEstimator {
   AntposeFilterParams p_;
 };
 
-/// The parameters exposed to --param (name, default, help) and their mapping.
-std::vector<ParamSpec> antpose_filter_param_specs();
+/// The parameters exposed to --param (name, default, help) and their mapping. `offline`: the
+/// smoother's defaults (adaptive heading time constant on, see smoother.hpp).
+std::vector<ParamSpec> antpose_filter_param_specs(bool offline = false);
 AntposeFilterParams antpose_filter_params(const EstimatorParams& params, const char* method);
 
 }  // namespace antpose::orientation

@@ -76,18 +76,8 @@ ImuData imu_data_from_capture(const Capture& capture, Diagnostics& diagnostics, 
   return data;
 }
 
-void check_imu_data(const ImuData& data, Diagnostics& d, const ImuCheckOptions& o) {
-  const std::pair<const SensorSeries*, const char*> all[] = {
-      {&data.gyroscope, "gyroscope"}, {&data.accelerometer, "accelerometer"}, {&data.magnetometer, "magnetometer"}};
-  for (const auto& [s, name] : all) {
-    for (std::size_t i = 0; i < s->size(); ++i)
-      if (!s->v[i].allFinite() || !std::isfinite(s->t[i]))
-        throw InputError(data.source, fmt::format("{} sample {} (t = {}) is not finite", name, i + 1, s->t[i]));
-    check_gaps(*s, name, o, d);
-  }
-
-  // Saturation: the same extreme value repeated on one axis.
-  const SensorSeries& g = data.gyroscope;
+std::vector<GyroSaturation> gyro_saturation(const SensorSeries& g, const ImuCheckOptions& o) {
+  std::vector<GyroSaturation> out;
   for (int axis = 0; axis < 3; ++axis) {
     double extreme = 0.0;
     for (const auto& v : g.v) extreme = std::max(extreme, std::abs(v[axis]));
@@ -101,13 +91,29 @@ void check_imu_data(const ImuData& data, Diagnostics& d, const ImuCheckOptions& 
         if (std::isnan(first)) first = g.t[i + 1 - run];
       }
     }
-    if (flagged > 0)
-      d.warn(fmt::format("orientation: the gyroscope {} axis sits at ±{:.3f} rad/s ({:.0f} °/s) for {} samples from t = "
-                         "{:.3f} s: saturated; rotation beyond the range is lost",
-                         "xyz"[axis], extreme, rad2deg(extreme), flagged + o.saturation_run - 1, first));
+    if (flagged > 0) out.push_back({axis, extreme, flagged + o.saturation_run - 1, first});
+  }
+  return out;
+}
+
+void check_imu_data(const ImuData& data, Diagnostics& d, const ImuCheckOptions& o) {
+  const std::pair<const SensorSeries*, const char*> all[] = {
+      {&data.gyroscope, "gyroscope"}, {&data.accelerometer, "accelerometer"}, {&data.magnetometer, "magnetometer"}};
+  for (const auto& [s, name] : all) {
+    for (std::size_t i = 0; i < s->size(); ++i)
+      if (!s->v[i].allFinite() || !std::isfinite(s->t[i]))
+        throw InputError(data.source, fmt::format("{} sample {} (t = {}) is not finite", name, i + 1, s->t[i]));
+    check_gaps(*s, name, o, d);
   }
 
+  // Saturation: the same extreme value repeated on one axis.
+  for (const GyroSaturation& sat : gyro_saturation(data.gyroscope, o))
+    d.warn(fmt::format("orientation: the gyroscope {} axis sits at ±{:.3f} rad/s ({:.0f} °/s) for {} samples from t = "
+                       "{:.3f} s: saturated; rotation beyond the range is lost",
+                       "xyz"[sat.axis], sat.level, rad2deg(sat.level), sat.samples, sat.first_t));
+
   // Bias at rest: mean gyroscope rate over windows where the accelerometer is still.
+  const SensorSeries& g = data.gyroscope;
   const SensorSeries& a = data.accelerometer;
   double worst = 0.0, worst_t = 0.0;
   std::size_t gi = 0;

@@ -88,6 +88,16 @@ ImuData imu_data_from_capture(const Capture& capture, Diagnostics& diagnostics, 
 /// InputError naming the stream.
 void check_imu_data(const ImuData& data, Diagnostics& diagnostics, const ImuCheckOptions& options = {});
 
+/// A gyroscope axis that sits at its extreme value for runs of ≥ saturation_run samples.
+struct GyroSaturation {
+  int axis = 0;
+  double level = 0.0;       // rad/s, |value| at which the axis clips
+  std::size_t samples = 0;  // samples in such runs
+  double first_t = 0.0;     // s, start of the first run
+};
+/// The clipped axes of a gyroscope stream (the check behind check_imu_data's warning).
+std::vector<GyroSaturation> gyro_saturation(const SensorSeries& gyroscope, const ImuCheckOptions& options = {});
+
 enum class Sensor : std::uint8_t { kAccelerometer = 0, kMagnetometer = 1, kGyroscope = 2 };
 
 /// One sample of one stream in the merged, time-ordered sequence.

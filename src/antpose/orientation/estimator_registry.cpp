@@ -160,7 +160,7 @@ std::vector<EstimatorInfo> estimator_registry() {
                }});
   r.push_back({"antpose-smoother",
                "offline: the antpose filter forward and on the time-reversed log, fused per sample by uncertainty",
-               false, antpose_filter_param_specs(), [](const EstimatorParams& p) -> std::unique_ptr<OrientationEstimator> {
+               false, antpose_filter_param_specs(true), [](const EstimatorParams& p) -> std::unique_ptr<OrientationEstimator> {
                  return std::make_unique<AntposeSmoother>(antpose_filter_params(p, "antpose-smoother"));
                }});
   return r;

@@ -100,11 +100,16 @@ OrientationTrack AntposeSmoother::estimate(const ImuData& data, Diagnostics& dia
   const double Ts = data.gyroscope.median_interval();
   if (!(Ts > 0.0)) throw MeasurementError("antpose-smoother: the gyroscope has no usable sample interval");
 
-  AntposeFilter fwd(p_, Ts);
+  AntposeFilterParams p = p_;
+  if (p.gyro_clip_rad_s <= 0.0) {
+    const auto sat = gyro_saturation(data.gyroscope);
+    for (const auto& s : sat) p.gyro_clip_rad_s = p.gyro_clip_rad_s > 0.0 ? std::min(p.gyro_clip_rad_s, s.level) : s.level;
+  }
+  AntposeFilter fwd(p, Ts);
   const OrientationTrack forward = run_gyro_driven(fwd, data, initial_attitude(data), run_options(fwd.params()));
 
   const ImuData rev = time_reversed(data, !p_.gyro_trapezoid);
-  AntposeFilter bwd(p_, Ts);
+  AntposeFilter bwd(p, Ts);
   if (fwd.mag_reference_norm() > 0.0) bwd.set_initial_mag_reference(fwd.mag_reference_norm(), fwd.mag_reference_dip());
   bwd.set_initial_bias(-fwd.gyro_bias(), std::max(fwd.bias_sigma(), p_.bias_sigma_motion));
   const OrientationTrack backward = run_gyro_driven(bwd, rev, initial_attitude(rev), run_options(bwd.params()));
