@@ -8,7 +8,7 @@ $SUDO apt-get update -qq
 DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends \
   build-essential cmake ninja-build pkg-config git \
   libeigen3-dev libceres-dev libopencv-dev libopencv-contrib-dev libnanoflann-dev libtbb-dev \
-  libsqlite3-dev libyaml-cpp-dev libcli11-dev nlohmann-json3-dev libfmt-dev libspdlog-dev \
+  libsqlite3-dev libssl-dev libyaml-cpp-dev libcli11-dev nlohmann-json3-dev libfmt-dev libspdlog-dev \
   zlib1g-dev libpugixml-dev libgtest-dev libgmock-dev libbenchmark-dev
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release
 cmake --build build -j2

@@ -27,6 +27,7 @@ int main(int argc, char** argv) {
   antpose::cli::add_bench_command(app);
   antpose::cli::add_orientation_command(app);
   antpose::cli::add_calibrate_command(app);
+  antpose::cli::add_device_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
