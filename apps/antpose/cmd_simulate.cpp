@@ -191,6 +191,7 @@ void add_simulate_command(CLI::App& app) {
   cmd->add_option("--placement", o->placement, "Contact preset: top-up, top-down, top-right, top-left")->capture_default_str();
   cmd->add_option("--tremor-deg", o->tremor_deg, "Hand tremor, RMS rotation in deg (contact default 0.057)");
   cmd->callback([o, cmd] { run_simulate_imu(*o, *cmd); });
+  add_simulate_capture_command(*simulate);
 }
 
 }  // namespace antpose::cli

@@ -1,0 +1,107 @@
+// antpose calibrate camera: intrinsic calibration from photos of a board.
+//   antpose calibrate camera CAPTURE [--config FILE] [--fix-aspect-ratio] [--zero-tangent]
+//       [--fix-principal-point] [--intrinsics-guess FILE] [--flip] -o camera.yaml [--force] [--json OUT]
+// Command-line switches add to the config (they can only switch a constraint on).
+#include <filesystem>
+#include <string>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "antpose/camera/calibrate_camera.hpp"
+#include "antpose/io/text_file.hpp"
+#include "commands.hpp"
+
+namespace antpose::cli {
+namespace {
+namespace fs = std::filesystem;
+
+struct CameraArgs {
+  std::string capture, config, guess, output, json;
+  bool fix_aspect_ratio = false, zero_tangent = false, fix_principal_point = false, flip = false, force = false;
+};
+
+nlohmann::json to_json(const camera::CameraCalibrationResult& r) {
+  nlohmann::json j;
+  const auto& in = r.intrinsics;
+  j["image_width"] = in.width;
+  j["image_height"] = in.height;
+  j["fx"] = in.fx;
+  j["fy"] = in.fy;
+  j["cx"] = in.cx;
+  j["cy"] = in.cy;
+  j["distortion"] = in.distortion;
+  j["rms_px"] = r.rms_px;
+  j["sigma"] = {{"fx", r.sigma.fx}, {"fy", r.sigma.fy}, {"cx", r.sigma.cx}, {"cy", r.sigma.cy},
+                {"distortion", r.sigma.distortion}};
+  j["flags"] = r.flags;
+  j["flag_names"] = r.flag_names;
+  j["rounds"] = r.rounds;
+  for (const auto& im : r.images) {
+    nlohmann::json e{{"image", im.image}, {"used", im.used}, {"points", im.points}};
+    if (im.rms_px) e["rms_px"] = *im.rms_px;
+    if (!im.reason.empty()) e["reason"] = im.reason;
+    if (im.used) {
+      e["rvec"] = {im.rvec.x(), im.rvec.y(), im.rvec.z()};
+      e["tvec_m"] = {im.tvec.x(), im.tvec.y(), im.tvec.z()};
+    }
+    j["images"].push_back(e);
+  }
+  return j;
+}
+
+void run_camera(const CameraArgs& args) {
+  Diagnostics diagnostics;
+  camera::CalibrationSettings settings;
+  if (!args.config.empty()) settings = camera::read_calibration_settings(args.config, diagnostics);
+  settings.fix_aspect_ratio = settings.fix_aspect_ratio || args.fix_aspect_ratio;
+  settings.zero_tangent = settings.zero_tangent || args.zero_tangent;
+  settings.fix_principal_point = settings.fix_principal_point || args.fix_principal_point;
+  settings.flip_vertical = settings.flip_vertical || args.flip;
+  if (!args.guess.empty()) settings.intrinsics_guess = camera::read_camera_file(args.guess).intrinsics;
+  // Refuse an existing output before the (long) run rather than after it.
+  if (!args.force && fs::exists(args.output))
+    throw InputError(args.output, "exists already; pass --force to replace it");
+
+  camera::CameraCalibrationResult result;
+  try {
+    result = camera::calibrate_camera(
+        fs::path(args.capture), settings, diagnostics,
+        [](const camera::CalibrationImage& im, std::size_t done, std::size_t total) {
+          fmt::print(stderr, "[{}/{}] {}: {}\n", done, total, im.image,
+                     im.points > 0 ? fmt::format("{} points", im.points) : im.reason);
+        });
+  } catch (...) {
+    print_warnings(diagnostics);
+    throw;
+  }
+  print_warnings(diagnostics);
+  fmt::print("camera calibration of {} ({} {}x{})\n{}", args.capture, camera::to_string(result.board.type),
+             result.board.cols, result.board.rows, camera::describe(result));
+  camera::write_camera_file(args.output, result, args.force);
+  fmt::print("wrote {}\n", args.output);
+  if (!args.json.empty()) io::write_text_atomic(args.json, to_json(result).dump(2) + "\n");
+}
+
+}  // namespace
+
+void add_calibrate_camera_command(CLI::App& calibrate) {
+  auto args = std::make_shared<CameraArgs>();
+  auto* cmd = calibrate.add_subcommand("camera", "intrinsic camera calibration from photos of a board "
+                                                 "(camera-calibration capture); writes an OpenCV camera YAML");
+  cmd->add_option("capture", args->capture, "capture folder with shots.csv, images/ and board.yaml")->required();
+  cmd->add_option("--config", args->config, "settings: OpenCV calibration sample XML/YAML (<Settings>) or antpose "
+                                             "YAML; its board overrides board.yaml");
+  cmd->add_flag("--fix-aspect-ratio", args->fix_aspect_ratio, "keep fx/fy fixed (1, or the config's/guess's ratio)");
+  cmd->add_flag("--zero-tangent", args->zero_tangent, "assume zero tangential distortion (p1 = p2 = 0)");
+  cmd->add_flag("--fix-principal-point", args->fix_principal_point,
+                "keep the principal point at the image centre (or the guess's)");
+  cmd->add_option("--intrinsics-guess", args->guess, "camera YAML to start from (CALIB_USE_INTRINSIC_GUESS)");
+  cmd->add_flag("--flip", args->flip, "flip the photos around the horizontal axis before detection");
+  cmd->add_option("-o,--output", args->output, "camera YAML to write (OpenCV FileStorage)")->required();
+  cmd->add_flag("--force", args->force, "replace an existing output file");
+  cmd->add_option("--json", args->json, "also write the result as JSON");
+  cmd->callback([args] { run_camera(*args); });
+}
+
+}  // namespace antpose::cli
