@@ -1,0 +1,187 @@
+// antpose calibrate joint: camera–IMU rotation R_device_camera and time offset from photos of a
+// board (docs/camera-imu.md).
+//   antpose calibrate joint CAPTURE --camera camera.yaml [--method reference-free|thesis|both]
+//       [--orientation antpose[,antpose-smoother,...]] [--param k=v ...] [--time-offset S]
+//       [--fixed-time-offset] [--json OUT]
+#include <filesystem>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "antpose/calibration/board_reference.hpp"
+#include "antpose/calibration/camera_imu.hpp"
+#include "antpose/camera/board.hpp"
+#include "antpose/camera/board_pose.hpp"
+#include "antpose/camera/calibrate_camera.hpp"
+#include "antpose/io/text_file.hpp"
+#include "antpose/orientation/estimator.hpp"
+#include "commands.hpp"
+
+namespace antpose::cli {
+namespace {
+namespace fs = std::filesystem;
+
+struct JointArgs {
+  std::string capture, camera, json;
+  std::string method = "both";
+  std::string orientation = "antpose";
+  std::vector<std::string> params;
+  double time_offset = 0.0;
+  bool fixed_time_offset = false;
+};
+
+std::vector<std::string> split_commas(const std::string& text) {
+  std::vector<std::string> out;
+  std::stringstream ss(text);
+  for (std::string item; std::getline(ss, item, ',');)
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
+
+nlohmann::json matrix_json(const Mat3& R) {
+  nlohmann::json j = nlohmann::json::array();
+  for (int r = 0; r < 3; ++r) j.push_back({R(r, 0), R(r, 1), R(r, 2)});
+  return j;
+}
+
+nlohmann::json table_json(const calibration::AngleErrorTable& t) {
+  auto row = [](const calibration::AngleErrorRow& r) {
+    nlohmann::json j{{"placement", r.placement}, {"photos", r.photos}, {"g_lines", r.g_lines}, {"n_lines", r.n_lines},
+                     {"n_lines_steep", r.n_lines_steep}};
+    if (!std::isnan(r.downtilt_error_deg)) j["downtilt_error_deg"] = r.downtilt_error_deg;
+    if (!std::isnan(r.azimuth_error_deg)) j["azimuth_error_deg"] = r.azimuth_error_deg;
+    return j;
+  };
+  nlohmann::json j{{"method", t.method}, {"matrix", t.matrix}, {"overall", row(t.overall)}};
+  for (const auto& r : t.placements) j["placements"].push_back(row(r));
+  return j;
+}
+
+void run_joint(const JointArgs& args) {
+  if (args.method != "reference-free" && args.method != "thesis" && args.method != "both")
+    throw InputError("--method", fmt::format("'{}' is not a method, expected reference-free, thesis or both", args.method));
+  const auto methods = split_commas(args.orientation);
+  if (methods.empty()) throw InputError("--orientation", "no orientation method given");
+  Diagnostics diagnostics;
+  try {
+    const Capture capture = read_capture(args.capture, diagnostics);
+    const fs::path root = args.capture;
+    const auto board = camera::read_board(root / "board.yaml");
+    const auto intrinsics = camera::read_camera_file(args.camera).intrinsics;
+    const auto placements = calibration::shot_placements(capture);
+    std::optional<calibration::BoardReference> reference;
+    for (const char* name : {"board_reference.csv", "board_reference.csv.gz"})
+      if (fs::is_regular_file(root / name)) {
+        reference = calibration::read_board_reference(root / name);
+        calibration::check_board_reference(*reference, placements);
+        break;
+      }
+    if (args.method == "thesis" && !reference)
+      throw InputError(root / "board_reference.csv", "missing: the thesis method needs the level/compass angles");
+
+    const auto poses = camera::board_poses(capture, board, intrinsics, diagnostics);
+    const auto photos = calibration::photo_observations(capture, poses);
+    fmt::print("{} of {} photos with a board pose\n", photos.size(), capture.shots.size());
+
+    const auto data = orientation::imu_data_from_capture(capture, diagnostics);
+    const auto params = orientation::parse_params(args.params);
+    std::vector<orientation::OrientationTrack> tracks;
+    for (const auto& m : methods) tracks.push_back(orientation::make_estimator(m, params)->estimate(data, diagnostics));
+
+    nlohmann::json j;
+    j["capture"] = args.capture;
+    std::optional<double> offset_for_thesis;
+    if (args.method != "thesis") {
+      calibration::ReferenceFreeOptions options;
+      options.time_offset_start_s = args.time_offset;
+      options.estimate_time_offset = !args.fixed_time_offset;
+      const auto r = calibration::calibrate_reference_free(photos, tracks.front(), options, diagnostics,
+                                                           reference ? &*reference : nullptr);
+      offset_for_thesis = r.time_offset_s;
+      const Vec3 s = r.rotation_sigma_deg();
+      const Vec3 e = log_so3(camera::nominal_R_device_camera().transpose() * r.R_device_camera);
+      fmt::print("reference-free (orientation '{}'):\n", tracks.front().method);
+      for (int k = 0; k < 3; ++k)
+        fmt::print("  R_device_camera [{:9.6f} {:9.6f} {:9.6f}]\n", r.R_device_camera(k, 0), r.R_device_camera(k, 1),
+                   r.R_device_camera(k, 2));
+      fmt::print("  = nominal · exp(({:.3f}, {:.3f}, {:.3f})°), 1σ ({:.3f}, {:.3f}, {:.3f})° (device frame)\n",
+                 rad2deg(e.x()), rad2deg(e.y()), rad2deg(e.z()), s.x(), s.y(), s.z());
+      if (r.time_offset_estimated)
+        fmt::print("  time offset {:.1f} ± {:.1f} ms (IMU instant = shot t + offset)\n", 1e3 * r.time_offset_s,
+                   1e3 * r.time_offset_sigma_s);
+      else
+        fmt::print("  time offset fixed at {:.1f} ms\n", 1e3 * r.time_offset_s);
+      fmt::print("  {:<28} {:<16} {:>8} {:>8} {:>9}\n", "photo", "placement", "angle°", "tilt°", "heading°");
+      for (const auto& p : r.residuals)
+        fmt::print("  {:<28} {:<16} {:8.3f} {:8.3f} {:9.3f}{}\n", p.name, p.placement, p.angle_deg, p.tilt_deg,
+                   p.heading_deg, p.outlier ? "  outlier" : "");
+      if (r.reference_check) fmt::print("{}", calibration::format_angle_error_table(*r.reference_check));
+      nlohmann::json rf{{"orientation", tracks.front().method},
+                        {"R_device_camera", matrix_json(r.R_device_camera)},
+                        {"rotation_sigma_deg", {s.x(), s.y(), s.z()}},
+                        {"time_offset_s", r.time_offset_s},
+                        {"time_offset_estimated", r.time_offset_estimated},
+                        {"variance_factor", r.variance_factor},
+                        {"warnings", r.warnings}};
+      if (r.time_offset_estimated) rf["time_offset_sigma_s"] = r.time_offset_sigma_s;
+      for (const auto& p : r.residuals)
+        rf["photos"].push_back({{"name", p.name}, {"placement", p.placement}, {"angle_deg", p.angle_deg},
+                                {"tilt_deg", p.tilt_deg}, {"heading_deg", p.heading_deg}, {"outlier", p.outlier}});
+      for (const auto& b : r.boards)
+        rf["boards"].push_back({{"placement", b.placement}, {"R_world_board", matrix_json(b.R_world_board)},
+                                {"photos", b.photos}, {"rms_deg", b.rms_deg}});
+      if (r.reference_check) rf["reference_check"] = table_json(*r.reference_check);
+      j["reference_free"] = rf;
+    }
+    if (args.method != "reference-free" && reference) {
+      calibration::ThesisOptions options;
+      options.time_offset_s = offset_for_thesis.value_or(args.time_offset);
+      std::vector<calibration::ThesisCalibration> results;
+      for (const auto& track : tracks) results.push_back(calibration::calibrate_thesis(photos, *reference, track, options, diagnostics));
+      fmt::print("thesis method (time offset {:.1f} ms):\n{}", 1e3 * options.time_offset_s,
+                 calibration::format_thesis_tables(results));
+      for (const auto& r : results)
+        j["thesis"].push_back({{"orientation", r.method},
+                               {"R_device_camera", matrix_json(r.R_device_camera)},
+                               {"rotation_sigma_deg",
+                                {rad2deg(std::sqrt(r.covariance(0, 0))), rad2deg(std::sqrt(r.covariance(1, 1))),
+                                 rad2deg(std::sqrt(r.covariance(2, 2)))}},
+                               {"optimised", table_json(r.optimised)},
+                               {"nominal", table_json(r.nominal)}});
+    }
+    print_warnings(diagnostics);
+    if (!args.json.empty()) io::write_text_atomic(args.json, j.dump(2) + "\n");
+  } catch (...) {
+    print_warnings(diagnostics);
+    throw;
+  }
+}
+
+}  // namespace
+
+void add_calibrate_joint_command(CLI::App& calibrate) {
+  auto args = std::make_shared<JointArgs>();
+  auto* cmd = calibrate.add_subcommand("joint", "camera–IMU rotation R_device_camera and time offset from photos of a "
+                                                "board (joint-calibration capture with a placement column)");
+  cmd->add_option("capture", args->capture, "capture folder: sensors, shots.csv with placement, images/, board.yaml, "
+                                            "optional board_reference.csv")
+      ->required();
+  cmd->add_option("--camera", args->camera, "camera YAML with the intrinsics (antpose calibrate camera)")->required();
+  cmd->add_option("--method", args->method, "reference-free, thesis (needs board_reference.csv) or both")
+      ->capture_default_str();
+  cmd->add_option("--orientation", args->orientation,
+                  "comma-separated orientation methods; the first serves the reference-free method, the thesis "
+                  "tables list each")
+      ->capture_default_str();
+  cmd->add_option("--param", args->params, "orientation parameter name=value (repeatable)");
+  cmd->add_option("--time-offset", args->time_offset, "start (or fixed) camera–IMU time offset, s")->capture_default_str();
+  cmd->add_flag("--fixed-time-offset", args->fixed_time_offset, "do not estimate the time offset");
+  cmd->add_option("--json", args->json, "also write the result as JSON");
+  cmd->callback([args] { run_joint(*args); });
+}
+
+}  // namespace antpose::cli

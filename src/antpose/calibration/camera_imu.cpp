@@ -1,0 +1,750 @@
+#include "antpose/calibration/camera_imu.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <map>
+
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
+#include <Eigen/Eigenvalues>
+#include <Eigen/SVD>
+#include <ceres/ceres.h>
+#include <ceres/rotation.h>
+#include <fmt/format.h>
+
+#include "antpose/calibration/least_squares.hpp"
+#include "antpose/camera/camera_model.hpp"
+
+namespace antpose::calibration {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+void warn(Diagnostics& diagnostics, std::vector<std::string>& warnings, std::string message) {
+  warnings.push_back(message);
+  diagnostics.warn(std::move(message));
+}
+
+std::string describe(const PhotoObservation& p, std::size_t index) {
+  return p.name.empty() ? fmt::format("photo {}", index) : p.name;
+}
+
+/// R_world_device at `t`, clamped into the track's span (used only for the small excursions of a
+/// time-offset search: photos outside the span are rejected before).
+Mat3 device_rotation(const orientation::OrientationTrack& track, double t) {
+  return track.at(std::clamp(t, track.t.front(), track.t.back())).q_world_device.toRotationMatrix();
+}
+
+/// Covariance (rad², world) of the track at t, or the defaults (tilt, tilt, heading).
+Mat3 device_covariance(const orientation::OrientationTrack& track, double t, double tilt_sigma, double heading_sigma) {
+  const auto s = track.at(std::clamp(t, track.t.front(), track.t.back()));
+  if (s.covariance && s.covariance->allFinite() && s.covariance->trace() > 0.0) return *s.covariance;
+  return Vec3(tilt_sigma * tilt_sigma, tilt_sigma * tilt_sigma, heading_sigma * heading_sigma).asDiagonal();
+}
+
+/// Angular velocity in the world frame (rad/s), Ṙ = [ω]× R, by a central difference over ±h.
+Vec3 world_rate(const orientation::OrientationTrack& track, double t, double h = 0.005) {
+  const double a = std::clamp(t - h, track.t.front(), track.t.back());
+  const double b = std::clamp(t + h, track.t.front(), track.t.back());
+  if (b <= a) return Vec3::Zero();
+  return log_so3(device_rotation(track, b) * device_rotation(track, a).transpose()) / (b - a);
+}
+
+Vec3 board_axis(BoardAxis axis) { return Vec3::Unit(static_cast<int>(axis)); }
+
+double wrapped_difference(double a, double b) { return wrap_pi(a - b); }
+
+// ---- thesis method ----------------------------------------------------------------------------
+
+/// Weight of a reference line: w1 (G), w2 (N), w3 (N of a steep axis). An axis is steep when its
+/// G angle — measured on the same placement if there is such a line, else predicted with X —
+/// is within steep_axis_deg of 0 or 180°.
+struct LineWeighting {
+  double weight = 0.0;
+  bool steep = false;
+};
+
+LineWeighting line_weight(const BoardReferenceLine& line, const std::vector<BoardReferenceLine>& placement_lines,
+                          const std::vector<Mat3>& predicted_R_world_board, const ThesisOptions& options) {
+  if (line.ref == AngleReference::kGravity) return {options.w1, false};
+  double g = kNaN;
+  for (const auto& other : placement_lines)
+    if (other.axis == line.axis && other.ref == AngleReference::kGravity) g = other.angle;
+  if (std::isnan(g) && !predicted_R_world_board.empty()) {
+    double sum = 0.0;
+    for (const auto& R : predicted_R_world_board) sum += reference_angle(R, line.axis, AngleReference::kGravity);
+    g = sum / static_cast<double>(predicted_R_world_board.size());
+  }
+  const double steep_limit = deg2rad(options.steep_axis_deg);
+  const bool steep = !std::isnan(g) && std::min(g, std::numbers::pi - g) < steep_limit;
+  return {steep ? options.w3 : options.w2, steep};
+}
+
+/// One photo × line term: the predicted angle of axis k of R_world_device exp(x) u_device.
+struct ThesisResidual {
+  Mat3 R_world_device;
+  Vec3 u_device;  // X0 R_camera_board e_k
+  AngleReference ref;
+  double measured;
+  double weight;
+
+  template <typename T>
+  bool operator()(const T* x, T* residual) const {
+    const T u[3] = {T(u_device.x()), T(u_device.y()), T(u_device.z())};
+    T w[3];
+    ceres::AngleAxisRotatePoint(x, u, w);
+    T v[3];
+    for (int r = 0; r < 3; ++r) v[r] = R_world_device(r, 0) * w[0] + R_world_device(r, 1) * w[1] + R_world_device(r, 2) * w[2];
+    if (ref == AngleReference::kGravity) {
+      // atan2(|v_horizontal|, −v_up): accurate near 0 and 180° (acos is not); the tiny constant
+      // keeps the derivative finite for an exactly vertical axis.
+      const T predicted = ceres::atan2(ceres::sqrt(v[0] * v[0] + v[1] * v[1] + T(1e-30)), -v[2]);
+      residual[0] = T(weight) * (predicted - T(measured));
+    } else {
+      const T d = ceres::atan2(v[0], v[1]) - T(measured);  // clockwise from north: atan2(east, north)
+      residual[0] = T(weight) * ceres::atan2(ceres::sin(d), ceres::cos(d));
+    }
+    return true;
+  }
+};
+
+/// Covariance of the thesis fit's single 3-parameter block. The residuals of one placement share
+/// its level/compass errors and the track's heading error there, so they are not independent:
+/// with G ≥ 4 placements the cluster-robust (sandwich) estimator
+///   (JᵀJ)⁻¹ [Σ_g (J_gᵀ r_g)(J_gᵀ r_g)ᵀ] (JᵀJ)⁻¹ · G/(G−1)
+/// (Liang & Zeger, Biometrika 73(1), 1986) is used; with fewer, the ordinary σ̂² (JᵀJ)⁻¹, which
+/// is then optimistic.
+Mat3 thesis_covariance(ceres::Problem& problem, const std::vector<std::size_t>& cluster, std::size_t residuals) {
+  double cost = 0.0;
+  std::vector<double> r;
+  ceres::CRSMatrix crs;
+  problem.Evaluate(ceres::Problem::EvaluateOptions(), &cost, &r, nullptr, &crs);
+  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(crs.num_rows, crs.num_cols);
+  for (int i = 0; i < crs.num_rows; ++i)
+    for (int k = crs.rows[i]; k < crs.rows[i + 1]; ++k) J(i, crs.cols[k]) = crs.values[k];
+  const Mat3 H = J.transpose() * J;
+  Eigen::FullPivLU<Mat3> lu(H);
+  if (!lu.isInvertible() || residuals <= 3) return Mat3::Zero();
+  const Mat3 H_inv = lu.inverse();
+  std::map<std::size_t, Vec3> score;
+  for (int i = 0; i < crs.num_rows; ++i) {
+    auto [it, fresh] = score.try_emplace(cluster[static_cast<std::size_t>(i)], Vec3::Zero());
+    it->second += J.row(i).transpose() * r[static_cast<std::size_t>(i)];
+  }
+  const double G = static_cast<double>(score.size());
+  if (G < 4) return H_inv * (2.0 * cost / static_cast<double>(residuals - 3));
+  Mat3 meat = Mat3::Zero();
+  for (const auto& [g, v] : score) meat += v * v.transpose();
+  return H_inv * meat * H_inv * (G / (G - 1.0));
+}
+
+struct UsablePhoto {
+  std::size_t index;
+  Mat3 R_world_device;
+};
+
+/// Photos inside the track (others warned about and left out), at IMU time t_shot + dt.
+std::vector<UsablePhoto> photos_in_track(const std::vector<PhotoObservation>& photos,
+                                         const orientation::OrientationTrack& track, double dt,
+                                         Diagnostics& diagnostics, std::vector<std::string>* warnings) {
+  if (track.empty()) throw MeasurementError(fmt::format("orientation track '{}' is empty", track.method));
+  std::vector<UsablePhoto> out;
+  for (std::size_t i = 0; i < photos.size(); ++i) {
+    const Mat3& R = photos[i].R_camera_board;
+    if (!std::isfinite(photos[i].t_shot) || !R.allFinite() ||
+        (R.transpose() * R - Mat3::Identity()).cwiseAbs().maxCoeff() > 1e-6 || R.determinant() < 0)
+      throw MeasurementError(fmt::format("{}: shot time {} or R_camera_board is not a finite rotation",
+                                         describe(photos[i], i), photos[i].t_shot));
+    const double t = photos[i].t_shot + dt;
+    if (!track.contains(t)) {
+      if (warnings)
+        warn(diagnostics, *warnings,
+             fmt::format("{} (t = {:.3f} s) lies outside the orientation track '{}' [{:.3f}, {:.3f}] s; left out",
+                         describe(photos[i], i), photos[i].t_shot, track.method, track.t.front(), track.t.back()));
+      continue;
+    }
+    out.push_back({i, track.at(t).q_world_device.toRotationMatrix()});
+  }
+  return out;
+}
+
+}  // namespace
+
+std::vector<PhotoObservation> photo_observations(const Capture& capture,
+                                                 const std::vector<camera::PhotoBoardPose>& poses) {
+  const auto placements = shot_placements(capture);
+  std::vector<PhotoObservation> out;
+  for (const auto& p : poses) {
+    if (!p.pose) continue;
+    if (p.shot_index >= capture.shots.size())
+      throw std::invalid_argument(fmt::format("photo_observations: shot index {} out of range", p.shot_index));
+    const auto& shot = capture.shots[p.shot_index];
+    PhotoObservation o;
+    o.t_shot = p.t;
+    o.placement = placements[p.shot_index];
+    o.R_camera_board = p.pose->R_camera_board;
+    o.cov_R_camera_board = p.pose->covariance.topLeftCorner<3, 3>();
+    o.name = fmt::format("shot {} ({})", shot.index, p.image);
+    out.push_back(std::move(o));
+  }
+  return out;
+}
+
+double reference_angle(const Mat3& R_world_board, BoardAxis axis, AngleReference ref) {
+  const Vec3 v = R_world_board * board_axis(axis);
+  if (ref == AngleReference::kGravity) return std::atan2(v.head<2>().norm(), -v.z());
+  if (v.head<2>().norm() == 0.0) return kNaN;
+  return wrap_2pi(std::atan2(v.x(), v.y()));
+}
+
+AngleErrorTable reference_angle_errors(const std::vector<PhotoObservation>& photos, const BoardReference& reference,
+                                       const orientation::OrientationTrack& track, const Mat3& R_device_camera,
+                                       double time_offset_s, const ThesisOptions& options, std::string matrix_label) {
+  Diagnostics quiet;
+  const auto usable = photos_in_track(photos, track, time_offset_s, quiet, nullptr);
+  AngleErrorTable table;
+  table.method = track.method;
+  table.matrix = std::move(matrix_label);
+  double g_sum_all = 0, n_sum_all = 0;
+  std::size_t g_count_all = 0, n_count_all = 0;
+  table.overall.placement = "all";
+  for (const auto& placement : reference.placements()) {
+    const auto lines = reference.lines_of(placement);
+    std::vector<Mat3> predicted;
+    for (const auto& u : usable)
+      if (photos[u.index].placement == placement)
+        predicted.push_back(u.R_world_device * R_device_camera * photos[u.index].R_camera_board);
+    AngleErrorRow row;
+    row.placement = placement;
+    row.photos = predicted.size();
+    double g_sum = 0, n_sum = 0;
+    std::size_t g_count = 0, n_count = 0;
+    for (const auto& line : lines) {
+      const auto lw = line_weight(line, lines, predicted, options);
+      if (lw.weight == 0.0) {
+        row.n_lines_steep += line.ref == AngleReference::kNorth ? 1 : 0;
+        continue;
+      }
+      (line.ref == AngleReference::kGravity ? row.g_lines : row.n_lines) += 1;
+      for (const auto& R : predicted) {
+        const double a = reference_angle(R, line.axis, line.ref);
+        if (std::isnan(a)) continue;
+        if (line.ref == AngleReference::kGravity) {
+          g_sum += std::abs(a - line.angle);
+          ++g_count;
+        } else {
+          n_sum += std::abs(wrapped_difference(a, line.angle));
+          ++n_count;
+        }
+      }
+    }
+    if (g_count) row.downtilt_error_deg = rad2deg(g_sum / static_cast<double>(g_count));
+    if (n_count) row.azimuth_error_deg = rad2deg(n_sum / static_cast<double>(n_count));
+    g_sum_all += g_sum, n_sum_all += n_sum, g_count_all += g_count, n_count_all += n_count;
+    table.overall.photos += row.photos;
+    table.overall.g_lines += row.g_lines;
+    table.overall.n_lines += row.n_lines;
+    table.overall.n_lines_steep += row.n_lines_steep;
+    table.placements.push_back(std::move(row));
+  }
+  if (g_count_all) table.overall.downtilt_error_deg = rad2deg(g_sum_all / static_cast<double>(g_count_all));
+  if (n_count_all) table.overall.azimuth_error_deg = rad2deg(n_sum_all / static_cast<double>(n_count_all));
+  return table;
+}
+
+ThesisCalibration calibrate_thesis(const std::vector<PhotoObservation>& photos, const BoardReference& reference,
+                                   const orientation::OrientationTrack& track, const ThesisOptions& options,
+                                   Diagnostics& diagnostics) {
+  ThesisCalibration out;
+  out.method = track.method;
+  if (!(options.w1 >= 0 && options.w2 >= 0 && options.w3 >= 0))
+    throw std::invalid_argument("calibrate_thesis: weights must be non-negative");
+  if (track.world != "enu-magnetic")
+    warn(diagnostics, out.warnings,
+         fmt::format("orientation track '{}' is {}, but board_reference N angles are magnetic (compass)", track.method,
+                     track.world));
+  const Mat3 X0 = options.start == ThesisOptions::Start::kNominal   ? camera::nominal_R_device_camera()
+                  : options.start == ThesisOptions::Start::kIdentity ? Mat3::Identity()
+                                                                     : nearest_rotation(options.R_start);
+  const auto usable = photos_in_track(photos, track, options.time_offset_s, diagnostics, &out.warnings);
+
+  double x[3] = {0.0, 0.0, 0.0};  // X = exp(x) X0, x a device-frame rotation vector
+  ceres::Problem problem;
+  std::vector<std::size_t> cluster;  // placement of each residual
+  std::size_t placement_index = 0;
+  for (const auto& placement : reference.placements()) {
+    ++placement_index;
+    const auto lines = reference.lines_of(placement);
+    std::vector<const UsablePhoto*> members;
+    std::vector<Mat3> predicted;
+    for (const auto& u : usable)
+      if (photos[u.index].placement == placement) {
+        members.push_back(&u);
+        predicted.push_back(u.R_world_device * X0 * photos[u.index].R_camera_board);
+      }
+    bool had_n = false, kept_n = false;
+    for (const auto& line : lines) {
+      const auto lw = line_weight(line, lines, predicted, options);
+      if (line.ref == AngleReference::kNorth) {
+        had_n = true;
+        kept_n = kept_n || lw.weight > 0.0;
+      }
+      if (lw.weight == 0.0) continue;
+      for (const auto* u : members) {
+        const Vec3 u_device = X0 * photos[u->index].R_camera_board * board_axis(line.axis);
+        problem.AddResidualBlock(new ceres::AutoDiffCostFunction<ThesisResidual, 1, 3>(
+                                     new ThesisResidual{u->R_world_device, u_device, line.ref, line.angle, lw.weight}),
+                                 nullptr, x);
+        cluster.push_back(placement_index);
+        ++out.residuals;
+      }
+    }
+    if (had_n && !kept_n)
+      warn(diagnostics, out.warnings,
+           fmt::format("placement '{}': every N line is of an axis within {}° of the vertical (ill-defined azimuth, "
+                       "weight w3 = 0); the placement does not constrain the heading",
+                       placement, options.steep_axis_deg));
+  }
+  if (out.residuals == 0)
+    throw MeasurementError(fmt::format(
+        "thesis method: no photo of a placement in {} lies inside orientation track '{}' with a reference line of "
+        "non-zero weight",
+        reference.file.string(), track.method));
+  const auto summary = solve_levenberg_marquardt(problem, options.max_iterations, 1e-12);
+  out.iterations = static_cast<int>(summary.iterations.size());
+  out.converged = summary.termination_type == ceres::CONVERGENCE;
+  out.R_device_camera = exp_so3(Vec3(x[0], x[1], x[2])) * X0;
+  out.rms_weighted_deg = rad2deg(std::sqrt(2.0 * summary.final_cost / static_cast<double>(out.residuals)));
+  out.covariance = thesis_covariance(problem, cluster, out.residuals);
+  if (!out.converged)
+    warn(diagnostics, out.warnings,
+         fmt::format("thesis method ({}): Levenberg–Marquardt stopped without convergence ({})", track.method,
+                     summary.message));
+  out.optimised = reference_angle_errors(photos, reference, track, out.R_device_camera, options.time_offset_s, options,
+                                         "optimised");
+  out.nominal = reference_angle_errors(photos, reference, track, camera::nominal_R_device_camera(),
+                                       options.time_offset_s, options, "nominal");
+  return out;
+}
+
+namespace {
+std::string cell(double v) { return std::isnan(v) ? std::string("     -") : fmt::format("{:6.2f}", v); }
+}  // namespace
+
+std::string format_angle_error_table(const AngleErrorTable& table) {
+  std::string s = fmt::format("orientation '{}', R_device_camera {}: mean absolute errors (deg)\n", table.method,
+                              table.matrix);
+  s += fmt::format("{:<20} {:>6} {:>3} {:>3} {:>9} {:>9}\n", "placement", "photos", "G", "N", "downtilt", "azimuth");
+  auto row = [&](const AngleErrorRow& r) {
+    s += fmt::format("{:<20} {:>6} {:>3} {:>3}    {}    {}\n", r.placement, r.photos, r.g_lines, r.n_lines,
+                     cell(r.downtilt_error_deg), cell(r.azimuth_error_deg));
+  };
+  for (const auto& r : table.placements) row(r);
+  row(table.overall);
+  return s;
+}
+
+std::string format_thesis_tables(const std::vector<ThesisCalibration>& results) {
+  std::string s;
+  for (const auto& r : results) {
+    s += fmt::format("orientation '{}': mean absolute errors (deg), optimised vs nominal R_device_camera\n", r.method);
+    s += fmt::format("{:<20} {:>6} {:>3} {:>3} | {:>9} {:>9} | {:>9} {:>9}\n", "placement", "photos", "G", "N",
+                     "downtilt", "(nominal)", "azimuth", "(nominal)");
+    const auto n = r.optimised.placements.size();
+    for (std::size_t i = 0; i <= n; ++i) {
+      const auto& o = i < n ? r.optimised.placements[i] : r.optimised.overall;
+      const auto& m = i < n ? r.nominal.placements[i] : r.nominal.overall;
+      s += fmt::format("{:<20} {:>6} {:>3} {:>3} |    {}    {} |    {}    {}\n", o.placement, o.photos, o.g_lines,
+                       o.n_lines, cell(o.downtilt_error_deg), cell(m.downtilt_error_deg), cell(o.azimuth_error_deg),
+                       cell(m.azimuth_error_deg));
+    }
+    const Vec3 e = log_so3(camera::nominal_R_device_camera().transpose() * r.R_device_camera);
+    s += fmt::format("R_device_camera = nominal · exp(({:.3f}, {:.3f}, {:.3f})°), 1σ ({:.3f}, {:.3f}, {:.3f})°\n\n",
+                     rad2deg(e.x()), rad2deg(e.y()), rad2deg(e.z()), rad2deg(std::sqrt(r.covariance(0, 0))),
+                     rad2deg(std::sqrt(r.covariance(1, 1))), rad2deg(std::sqrt(r.covariance(2, 2))));
+  }
+  return s;
+}
+
+// ---- reference-free method --------------------------------------------------------------------
+
+Mat3 hand_eye_rotation(const std::vector<Mat3>& R_world_device, const std::vector<Mat3>& R_camera_board,
+                       const std::vector<std::size_t>& group) {
+  if (R_world_device.size() != R_camera_board.size() || group.size() != R_camera_board.size())
+    throw std::invalid_argument("hand_eye_rotation: inputs differ in size");
+  Mat3 H = Mat3::Zero();  // Σ β αᵀ, β = log B (camera), α = log A (device)
+  for (std::size_t i = 0; i < group.size(); ++i)
+    for (std::size_t j = i + 1; j < group.size(); ++j) {
+      if (group[i] != group[j]) continue;
+      const Vec3 alpha = log_so3(R_world_device[i].transpose() * R_world_device[j]);
+      const Vec3 beta = log_so3(R_camera_board[i] * R_camera_board[j].transpose());
+      H += beta * alpha.transpose();
+    }
+  // Kabsch: X = V diag(1, 1, det(V Uᵀ)) Uᵀ maximises tr(X H), i.e. minimises Σ ‖α − X β‖².
+  Eigen::JacobiSVD<Mat3> svd(H, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Mat3 D = Mat3::Identity();
+  D(2, 2) = (svd.matrixV() * svd.matrixU().transpose()).determinant() < 0 ? -1.0 : 1.0;
+  return svd.matrixV() * D * svd.matrixU().transpose();
+}
+
+Mat3 chordal_mean(const std::vector<Mat3>& rotations) {
+  Mat3 sum = Mat3::Zero();
+  for (const auto& R : rotations) sum += R;
+  return nearest_rotation(sum);
+}
+
+Vec3 ReferenceFreeCalibration::rotation_sigma_deg() const {
+  return covariance.diagonal().cwiseMax(0.0).cwiseSqrt() * (180.0 / std::numbers::pi);
+}
+
+store::CameraImuCalibration ReferenceFreeCalibration::to_profile() const {
+  store::CameraImuCalibration c;
+  c.R_device_camera = R_device_camera;
+  c.rotation_sigma_rad = covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
+  c.time_offset_s = time_offset_s;
+  if (time_offset_estimated) c.time_offset_sigma_s = time_offset_sigma_s;
+  c.method = "reference-free";
+  return c;
+}
+
+namespace {
+
+/// Whitened world-frame residual of one photo:
+///   r = L⁻¹ log( exp(ω Δ) R_ref exp(x) X0 R_camera_board R_world_board0ᵀ exp(−b) ),  Δ = δt − δt_ref,
+/// with R_ref = R_world_device(t_shot + δt_ref) and ω its world-frame rate (so exp(ωΔ) R_ref is
+/// R_world_device(t_shot + δt) to first order; the caller re-linearises until Δ → 0), and
+/// L Lᵀ = Σ_device + R_world_camera Σ_camera R_world_cameraᵀ (+ floor).
+struct BoardConsistencyResidual {
+  Mat3 R_ref;
+  Vec3 omega_world;
+  double dt_ref;
+  Mat3 C;        // X0 R_camera_board R_world_board0ᵀ
+  Mat3 W;        // L⁻¹
+
+  template <typename T>
+  bool operator()(const T* x, const T* b, const T* dt, T* residual) const {
+    using M3 = Eigen::Matrix<T, 3, 3>;
+    const T delta = dt[0] - T(dt_ref);
+    const T w[3] = {T(omega_world.x()) * delta, T(omega_world.y()) * delta, T(omega_world.z()) * delta};
+    const T minus_b[3] = {-b[0], -b[1], -b[2]};
+    M3 Rw, Rx, Rb;
+    ceres::AngleAxisToRotationMatrix(w, Rw.data());
+    ceres::AngleAxisToRotationMatrix(x, Rx.data());
+    ceres::AngleAxisToRotationMatrix(minus_b, Rb.data());
+    const M3 M = Rw * R_ref.cast<T>() * Rx * C.cast<T>() * Rb;
+    T e[3];
+    ceres::RotationMatrixToAngleAxis(M.data(), e);
+    for (int r = 0; r < 3; ++r) residual[r] = T(W(r, 0)) * e[0] + T(W(r, 1)) * e[1] + T(W(r, 2)) * e[2];
+    return true;
+  }
+};
+
+struct FreeProblem {
+  const std::vector<PhotoObservation>* photos = nullptr;
+  const orientation::OrientationTrack* track = nullptr;
+  const ReferenceFreeOptions* options = nullptr;
+  std::vector<std::size_t> index;  // used photos → input index
+  std::vector<std::size_t> group;  // used photo → placement
+  std::vector<std::string> placements;
+
+  Mat3 X0 = Mat3::Identity();
+  std::vector<Mat3> B0;            // R_world_board0 per placement
+  double x[3] = {0, 0, 0};
+  std::vector<std::array<double, 3>> b;
+  double dt = 0.0;
+
+  Mat3 X() const { return exp_so3(Vec3(x[0], x[1], x[2])) * X0; }
+  Mat3 board(std::size_t p) const { return exp_so3(Vec3(b[p][0], b[p][1], b[p][2])) * B0[p]; }
+
+  Mat3 photo_covariance(std::size_t k, const Mat3& R_world_device) const {
+    const auto& o = *options;
+    const auto& ph = (*photos)[index[k]];
+    Mat3 cov_c = ph.cov_R_camera_board;
+    Eigen::SelfAdjointEigenSolver<Mat3> es(0.5 * (cov_c + cov_c.transpose()));
+    if (!cov_c.allFinite() || es.eigenvalues().minCoeff() <= 0.0)
+      cov_c = Mat3::Identity() * std::pow(deg2rad(o.default_pnp_sigma_deg), 2);
+    const Mat3 R_wc = R_world_device * X0;
+    return device_covariance(*track, ph.t_shot + dt, deg2rad(o.default_tilt_sigma_deg),
+                             deg2rad(o.default_heading_sigma_deg)) +
+           R_wc * cov_c * R_wc.transpose() + Mat3::Identity() * std::pow(deg2rad(o.sigma_floor_deg), 2);
+  }
+
+  /// World-frame residual rotation vector of photo k at the current estimate (exact time).
+  Vec3 residual(std::size_t k) const {
+    const auto& ph = (*photos)[index[k]];
+    return log_so3(device_rotation(*track, ph.t_shot + dt) * X() * ph.R_camera_board * board(group[k]).transpose());
+  }
+
+  /// Result of solve(): final (whitened) cost of the last linearisation, and — when asked —
+  /// the unscaled covariance of x (rad², device frame) and the variance of δt (s²).
+  struct Solution {
+    double cost = 0.0;
+    std::size_t residuals = 0;
+    bool converged = false;
+    std::optional<Mat3> cov_x;
+    double var_dt = kNaN;
+  };
+
+  /// Solves with photos where `use[k]` (Huber loss when `robust`), re-linearising the time
+  /// offset until it moves less than 10 µs (at most 6 rounds).
+  Solution solve(const std::vector<bool>& use, bool robust, bool free_dt, bool want_covariance) {
+    Solution sol;
+    for (int round = 0; round < 6; ++round) {
+      const double dt_ref = dt;
+      ceres::Problem problem;
+      sol.residuals = 0;
+      for (std::size_t k = 0; k < index.size(); ++k) {
+        if (!use[k]) continue;
+        const auto& ph = (*photos)[index[k]];
+        const double t = ph.t_shot + dt_ref;
+        const Mat3 R_ref = device_rotation(*track, t);
+        const Mat3 cov = photo_covariance(k, R_ref);
+        const Mat3 W = Eigen::LLT<Mat3>(cov).matrixL().solve(Mat3::Identity());
+        const Mat3 C = X0 * ph.R_camera_board * B0[group[k]].transpose();
+        auto* cost = new ceres::AutoDiffCostFunction<BoardConsistencyResidual, 3, 3, 3, 1>(
+            new BoardConsistencyResidual{R_ref, world_rate(*track, t), dt_ref, C, W});
+        problem.AddResidualBlock(cost, robust ? new ceres::HuberLoss(options->huber_k) : nullptr, x, b[group[k]].data(),
+                                 &dt);
+        ++sol.residuals;
+      }
+      if (!free_dt) problem.SetParameterBlockConstant(&dt);
+      const auto summary = solve_levenberg_marquardt(problem, options->max_iterations, 1e-12);
+      sol.cost = summary.final_cost;
+      sol.converged = summary.termination_type == ceres::CONVERGENCE;
+      const bool settled = !free_dt || std::abs(dt - dt_ref) < 1e-5;
+      if (settled && want_covariance) {
+        ceres::Covariance::Options co;
+        co.algorithm_type = ceres::DENSE_SVD;
+        co.null_space_rank = -1;
+        ceres::Covariance covariance(co);
+        std::vector<std::pair<const double*, const double*>> blocks = {{x, x}};
+        if (free_dt) blocks.push_back({&dt, &dt});
+        if (covariance.Compute(blocks, &problem)) {
+          Eigen::Matrix<double, 3, 3, Eigen::RowMajor> c;
+          covariance.GetCovarianceBlock(x, x, c.data());
+          sol.cov_x = c;
+          if (free_dt) covariance.GetCovarianceBlock(&dt, &dt, &sol.var_dt);
+        }
+      }
+      if (settled) break;
+    }
+    return sol;
+  }
+};
+
+}  // namespace
+
+ReferenceFreeCalibration calibrate_reference_free(const std::vector<PhotoObservation>& photos,
+                                                  const orientation::OrientationTrack& track,
+                                                  const ReferenceFreeOptions& options, Diagnostics& diagnostics,
+                                                  const BoardReference* reference) {
+  ReferenceFreeCalibration out;
+  auto& warnings = out.warnings;
+  const auto usable = photos_in_track(photos, track, 0.0, diagnostics, &warnings);
+
+  // Group by placement (order of first appearance) and drop placements that cannot help.
+  std::vector<std::string> names;
+  std::map<std::string, std::vector<std::size_t>> members;  // placement → input indexes
+  for (const auto& u : usable) {
+    const auto& p = photos[u.index].placement;
+    if (!members.count(p)) names.push_back(p);
+    members[p].push_back(u.index);
+  }
+  FreeProblem fp;
+  fp.photos = &photos;
+  fp.track = &track;
+  fp.options = &options;
+  std::vector<std::string> dropped;
+  for (const auto& name : names) {
+    const auto& m = members[name];
+    if (m.size() < options.min_photos_per_placement) {
+      warn(diagnostics, warnings,
+           fmt::format("placement '{}' has {} usable photo(s), at least {} are needed; left out", name, m.size(),
+                       options.min_photos_per_placement));
+      dropped.push_back(name);
+      continue;
+    }
+    double largest = 0.0;
+    for (std::size_t a = 0; a < m.size(); ++a)
+      for (std::size_t c = a + 1; c < m.size(); ++c)
+        largest = std::max(largest, rotation_distance(photos[m[a]].R_camera_board, photos[m[c]].R_camera_board));
+    if (rad2deg(largest) < options.min_view_change_deg) {
+      warn(diagnostics, warnings,
+           fmt::format("placement '{}': all {} photos were taken from one pose (largest relative rotation {:.2f}°, "
+                       "need ≥ {}°): they cannot constrain R_device_camera (degenerate hand–eye); left out",
+                       name, m.size(), rad2deg(largest), options.min_view_change_deg));
+      dropped.push_back(name);
+      continue;
+    }
+    for (std::size_t i : m) {
+      fp.index.push_back(i);
+      fp.group.push_back(fp.placements.size());
+    }
+    fp.placements.push_back(name);
+  }
+  if (fp.placements.empty())
+    throw MeasurementError(fmt::format("camera–IMU calibration: no usable placement ({} photos given, {} inside the "
+                                       "orientation track; see the warnings)",
+                                       photos.size(), usable.size()));
+
+  // Observability of the rotation: the relative camera rotations must not all share one axis.
+  {
+    Mat3 S = Mat3::Zero();
+    std::size_t pairs = 0;
+    for (std::size_t i = 0; i < fp.index.size(); ++i)
+      for (std::size_t j = i + 1; j < fp.index.size(); ++j)
+        if (fp.group[i] == fp.group[j]) {
+          const Vec3 beta = log_so3(photos[fp.index[i]].R_camera_board * photos[fp.index[j]].R_camera_board.transpose());
+          S += beta * beta.transpose();
+          ++pairs;
+        }
+    const Eigen::SelfAdjointEigenSolver<Mat3> es(S / static_cast<double>(pairs));
+    const double spread = std::sqrt(std::max(0.0, es.eigenvalues()(1)));
+    if (rad2deg(spread) < options.min_axis_spread_deg)
+      throw MeasurementError(fmt::format(
+          "camera–IMU calibration: the views of every placement differ by rotations about one axis only (RMS rotation "
+          "off that axis {:.2f}°, need ≥ {}°): R_device_camera is not observable (degenerate hand–eye). Take the "
+          "photos of a placement from views tilted about two different axes",
+          rad2deg(spread), options.min_axis_spread_deg));
+  }
+
+  // Angular rates at the shots: without motion the time offset cannot be seen.
+  bool free_dt = options.estimate_time_offset;
+  double max_rate = 0.0;
+  for (std::size_t i : fp.index)
+    max_rate = std::max(max_rate, world_rate(track, photos[i].t_shot + options.time_offset_start_s).norm());
+  if (free_dt && rad2deg(max_rate) < options.min_rate_deg_s) {
+    warn(diagnostics, warnings,
+         fmt::format("time offset unobservable: the phone was still at every shot (largest rate {:.2f}°/s); δt fixed "
+                     "at {} s",
+                     rad2deg(max_rate), options.time_offset_start_s));
+    free_dt = false;
+  }
+
+  // Closed-form start at a given δt: hand–eye rotation, chordal board means, a truncated cost.
+  const std::size_t n = fp.index.size(), P = fp.placements.size();
+  std::vector<Mat3> R_cb(n);
+  for (std::size_t k = 0; k < n; ++k) R_cb[k] = photos[fp.index[k]].R_camera_board;
+  auto closed_form = [&](double dt, Mat3& X, std::vector<Mat3>& boards) {
+    std::vector<Mat3> R_wd(n);
+    for (std::size_t k = 0; k < n; ++k) R_wd[k] = device_rotation(track, photos[fp.index[k]].t_shot + dt);
+    X = options.R_start ? nearest_rotation(*options.R_start) : hand_eye_rotation(R_wd, R_cb, fp.group);
+    std::vector<std::vector<Mat3>> per(P);
+    for (std::size_t k = 0; k < n; ++k) per[fp.group[k]].push_back(R_wd[k] * X * R_cb[k]);
+    boards.resize(P);
+    for (std::size_t p = 0; p < P; ++p) boards[p] = chordal_mean(per[p]);
+    const double cap = deg2rad(2.0);
+    double cost = 0.0;
+    for (std::size_t k = 0; k < n; ++k)
+      cost += std::min(std::pow(rotation_distance(R_wd[k] * X * R_cb[k], boards[fp.group[k]]), 2), cap * cap);
+    return cost;
+  };
+  double dt0 = options.time_offset_start_s;
+  if (free_dt) {
+    if (!(options.time_offset_max_s > options.time_offset_min_s && options.time_offset_step_s > 0))
+      throw std::invalid_argument("calibrate_reference_free: empty time-offset bracket");
+    double best = std::numeric_limits<double>::infinity();
+    Mat3 X;
+    std::vector<Mat3> boards;
+    const int steps = static_cast<int>(
+        std::floor((options.time_offset_max_s - options.time_offset_min_s) / options.time_offset_step_s + 1e-9));
+    for (int s = 0; s <= steps; ++s) {
+      const double dt = options.time_offset_min_s + s * options.time_offset_step_s;
+      const double c = closed_form(dt, X, boards);
+      if (c < best) best = c, dt0 = dt;
+    }
+  }
+  if (free_dt && (dt0 <= options.time_offset_min_s + 0.5 * options.time_offset_step_s ||
+                  dt0 >= options.time_offset_max_s - 0.5 * options.time_offset_step_s))
+    warn(diagnostics, warnings,
+         fmt::format("time offset search ended at the edge of [{}, {}] s ({} s): widen the bracket", options.time_offset_min_s,
+                     options.time_offset_max_s, dt0));
+  out.time_offset_grid_s = dt0;
+  fp.dt = dt0;
+  closed_form(dt0, fp.X0, fp.B0);
+  out.R_device_camera_closed_form = fp.X0;
+  fp.b.assign(P, {0.0, 0.0, 0.0});
+
+  // Pass 1: Huber loss; flag outliers on the robustly normalised whitened residual.
+  std::vector<bool> use(n, true);
+  fp.solve(use, true, free_dt, false);
+  std::vector<double> chi2(n), angle(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    const auto& ph = photos[fp.index[k]];
+    const Mat3 cov = fp.photo_covariance(k, device_rotation(track, ph.t_shot + fp.dt));
+    const Vec3 e = fp.residual(k);
+    chi2[k] = e.dot(cov.ldlt().solve(e));
+    angle[k] = e.norm();
+  }
+  std::vector<double> sorted = chi2;
+  std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(n / 2), sorted.end());
+  const double scale = std::max(sorted[n / 2] / 2.366, 1e-12);  // median of χ²₃ is 2.366
+  std::size_t outliers = 0;
+  for (std::size_t k = 0; k < n; ++k)
+    if (chi2[k] / scale > options.outlier_chi2 && rad2deg(angle[k]) > options.min_outlier_deg) use[k] = false, ++outliers;
+  if (outliers > 0)
+    warn(diagnostics, warnings,
+         fmt::format("{} of {} photos are outliers (residual beyond χ²₃ = {} of the robust scale); refitted without them",
+                     outliers, n, options.outlier_chi2));
+  if (outliers * 3 > n)
+    warn(diagnostics, warnings, "more than a third of the photos are outliers: check the board detection and the track");
+
+  // Pass 2: least squares on the inliers, covariance from Ceres scaled by the residual variance.
+  const std::size_t params = 3 + 3 * P;
+  auto final_solve = [&](bool with_dt) {
+    const auto sol = fp.solve(use, false, with_dt, true);
+    const double dof = 3.0 * static_cast<double>(sol.residuals) - static_cast<double>(params + (with_dt ? 1 : 0));
+    out.variance_factor = dof > 0 ? 2.0 * sol.cost / dof : 1.0;
+    if (sol.cov_x) out.covariance = *sol.cov_x * out.variance_factor;
+    out.time_offset_estimated = with_dt;
+    out.time_offset_sigma_s = with_dt ? std::sqrt(std::max(0.0, sol.var_dt * out.variance_factor)) : kNaN;
+    if (!sol.converged)
+      warn(diagnostics, warnings, "reference-free fit: Levenberg–Marquardt stopped without convergence");
+  };
+  final_solve(free_dt);
+  if (free_dt && !(out.time_offset_sigma_s <= options.max_time_offset_sigma_s)) {
+    warn(diagnostics, warnings,
+         fmt::format("time offset unobservable: σ(δt) = {:.1f} ms exceeds {:.1f} ms (too little motion at the shots); "
+                     "δt fixed at {} s",
+                     1e3 * out.time_offset_sigma_s, 1e3 * options.max_time_offset_sigma_s,
+                     options.time_offset_start_s));
+    fp.dt = options.time_offset_start_s;
+    final_solve(false);
+  }
+  if (out.time_offset_estimated && (fp.dt < options.time_offset_min_s || fp.dt > options.time_offset_max_s))
+    warn(diagnostics, warnings,
+         fmt::format("time offset {:.4f} s lies outside the searched bracket [{}, {}] s", fp.dt,
+                     options.time_offset_min_s, options.time_offset_max_s));
+
+  out.R_device_camera = fp.X();
+  out.time_offset_s = fp.dt;
+  // Residuals (exact track time) and board attitudes.
+  std::vector<double> sum_sq(P, 0.0);
+  std::vector<std::size_t> count(P, 0);
+  for (std::size_t k = 0; k < n; ++k) {
+    const Vec3 e = fp.residual(k);
+    PhotoResidual r;
+    r.photo = fp.index[k];
+    r.name = describe(photos[r.photo], r.photo);
+    r.placement = photos[r.photo].placement;
+    r.angle_deg = rad2deg(e.norm());
+    r.tilt_deg = rad2deg(e.head<2>().norm());
+    r.heading_deg = rad2deg(e.z());
+    const Mat3 cov = fp.photo_covariance(k, device_rotation(track, photos[r.photo].t_shot + fp.dt));
+    r.normalised = e.dot(cov.ldlt().solve(e)) / (out.variance_factor > 0 ? out.variance_factor : 1.0);
+    r.outlier = !use[k];
+    if (r.outlier) out.outliers.push_back(r.photo);
+    else sum_sq[fp.group[k]] += e.squaredNorm(), ++count[fp.group[k]];
+    out.residuals.push_back(std::move(r));
+  }
+  for (std::size_t p = 0; p < P; ++p)
+    out.boards.push_back({fp.placements[p], fp.board(p), count[p],
+                          count[p] ? rad2deg(std::sqrt(sum_sq[p] / static_cast<double>(count[p]))) : kNaN});
+  if (reference)
+    out.reference_check = reference_angle_errors(photos, *reference, track, out.R_device_camera, out.time_offset_s,
+                                                 ThesisOptions{}, "reference-free");
+  return out;
+}
+
+}  // namespace antpose::calibration

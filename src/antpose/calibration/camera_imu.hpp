@@ -1,0 +1,210 @@
+// Camera–IMU calibration: the rotation R_device_camera (camera frame → Android device frame) and
+// the camera–IMU time offset, from photos of a calibration board (docs/camera-imu.md).
+//
+// Input per photo: the shot time, the board placement, and the board attitude in the camera
+// frame from PnP, R_camera_board, with its covariance (rad², camera frame: R_true = exp(δ) R_est).
+// The phone's attitude comes from an orientation track (orientation/estimator.hpp), whose
+// covariance is world-frame (δ_z heading, δ_x, δ_y tilt). With X = R_device_camera every photo
+// i of placement p predicts the board's world attitude
+//     R_world_board = R_world_device(t_i + δt) · X · R_camera_board_i.               (1)
+//
+// A. Thesis method (thesis §5.2–5.4): compare the angles of (1) with a level and a compass
+//    (board_reference.csv: G = angle from straight down, N = clockwise from north of the
+//    horizontal projection) and minimise Σ w² (predicted − measured)² over X (Levenberg–
+//    Marquardt, Ceres). Weights: w1 for G lines, w2 for N lines, w3 for N lines of a "steep"
+//    axis (within steep_axis_deg of the vertical), whose compass angle is ill-defined: its
+//    horizontal projection is short, so small tilts swing its azimuth (thesis eq. 5.13/5.14).
+//    w3 = 0 (default) drops those lines; a warning names a placement left without N line.
+// B. Reference-free (antpose): the board does not move within a placement, so every photo of
+//    placement p must give the same R_world_board_p. Unknowns X, every R_world_board_p and δt.
+//    Start: hand–eye rotation A X = X B on all photo pairs of a placement (Park & Martin 1994,
+//    rotation step, solved as an orthogonal Procrustes problem), board attitudes by chordal L2
+//    averaging (Hartley et al. 2013), δt by a grid search; then Ceres refines the whitened
+//    world-frame residuals log(R_world_device(t_i+δt) X R_camera_board_i R_world_board_p^T)
+//    under a Huber loss, flags outliers, and refits without them. Heading errors of the
+//    magnetometer that are common to a placement are absorbed by R_world_board_p (a rotation
+//    about the vertical on the left of (1)), so no per-placement heading nuisance is needed.
+#pragma once
+
+#include <cstddef>
+#include <limits>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "antpose/calibration/board_reference.hpp"
+#include "antpose/camera/board_pose.hpp"
+#include "antpose/core/error.hpp"
+#include "antpose/orientation/estimator.hpp"
+#include "antpose/store/device_profile.hpp"
+
+namespace antpose::calibration {
+
+/// One photo of the board.
+struct PhotoObservation {
+  double t_shot = 0.0;          // shots.csv t, s (capture clock); IMU instant = t_shot + δt
+  std::string placement;
+  Mat3 R_camera_board = Mat3::Identity();
+  Mat3 cov_R_camera_board = Mat3::Zero();  // rad², camera frame (R_true = exp(δ) R_est)
+  std::string name;             // for messages, e.g. "shot 7 (images/img_07.jpg)"
+};
+
+/// Observations from the board poses of a capture (camera::board_poses): placement from the
+/// shots' `placement` column (InputError as shot_placements), name "shot <index> (<image>)",
+/// covariance = the rotation block of the pose covariance. Shots without a pose are skipped
+/// (board_poses has warned about them).
+std::vector<PhotoObservation> photo_observations(const Capture& capture,
+                                                 const std::vector<camera::PhotoBoardPose>& poses);
+
+/// Predicted reference angle (rad) of a board axis for a board attitude R_world_board (world
+/// ENU-magnetic): G = angle from straight down in [0, π]; N = clockwise from north of the
+/// horizontal projection in [0, 2π) (NaN for an exactly vertical axis).
+double reference_angle(const Mat3& R_world_board, BoardAxis axis, AngleReference ref);
+
+// ---- A. thesis method ------------------------------------------------------------------------
+
+struct ThesisOptions {
+  enum class Start { kNominal, kIdentity, kGiven };
+  Start start = Start::kNominal;            // camera::nominal_R_device_camera(), I, or R_start
+  Mat3 R_start = Mat3::Identity();
+  double w1 = 1.0;    // G lines
+  double w2 = 0.2;    // N lines (≈ σ_G / σ_N of a level at ±0.2° and a compass at ±1.5°, plus heading noise)
+  double w3 = 0.0;    // N lines of steep axes (ill-defined azimuth)
+  double steep_axis_deg = 30.0;  // an axis within this angle of the vertical is steep
+  double time_offset_s = 0.0;    // IMU instant = t_shot + time_offset_s
+  int max_iterations = 100;
+};
+
+/// Mean absolute angle errors per placement (the thesis's tables): over every photo × line.
+struct AngleErrorRow {
+  std::string placement;
+  std::size_t photos = 0;
+  std::size_t g_lines = 0, n_lines = 0;   // lines used (photo × line counts are photos × these)
+  std::size_t n_lines_steep = 0;          // N lines left out (steep axis, weight 0)
+  double downtilt_error_deg = std::numeric_limits<double>::quiet_NaN();  // mean |ΔG|, NaN without G line
+  double azimuth_error_deg = std::numeric_limits<double>::quiet_NaN();   // mean |ΔN| (wrapped), NaN without N line
+};
+
+struct AngleErrorTable {
+  std::string method;   // orientation method (track.method)
+  std::string matrix;   // which R_device_camera: "optimised", "nominal", "reference-free", ...
+  std::vector<AngleErrorRow> placements;
+  AngleErrorRow overall;  // placement "all"
+};
+
+/// Angle errors of the reference lines predicted by (1) with the given X and δt. Photos of
+/// placements without lines are ignored; N lines whose weight is 0 (steep, w3 = 0) are counted
+/// in n_lines_steep and left out of the means.
+AngleErrorTable reference_angle_errors(const std::vector<PhotoObservation>& photos, const BoardReference& reference,
+                                       const orientation::OrientationTrack& track, const Mat3& R_device_camera,
+                                       double time_offset_s, const ThesisOptions& options, std::string matrix_label);
+
+struct ThesisCalibration {
+  std::string method;                     // orientation method of the track
+  Mat3 R_device_camera = Mat3::Identity();
+  Mat3 covariance = Mat3::Zero();         // rad², device frame; cluster-robust over placements (≥ 4)
+  double rms_weighted_deg = 0.0;          // RMS of the weighted angle residuals
+  std::size_t residuals = 0;              // photo × line terms
+  int iterations = 0;
+  bool converged = false;
+  AngleErrorTable optimised;              // with R_device_camera
+  AngleErrorTable nominal;                // with camera::nominal_R_device_camera()
+  std::vector<std::string> warnings;
+};
+
+/// Method A on one orientation track. MeasurementError when no photo has a reference line or
+/// every weight is 0; photos outside the track are left out with a warning naming them.
+ThesisCalibration calibrate_thesis(const std::vector<PhotoObservation>& photos, const BoardReference& reference,
+                                   const orientation::OrientationTrack& track, const ThesisOptions& options,
+                                   Diagnostics& diagnostics);
+
+/// The thesis's tables as text: per orientation method, mean |downtilt| and |azimuth| errors
+/// per placement and overall, with the optimised and the nominal matrix.
+std::string format_thesis_tables(const std::vector<ThesisCalibration>& results);
+/// One table (used by format_thesis_tables and for the reference check of method B).
+std::string format_angle_error_table(const AngleErrorTable& table);
+
+// ---- B. reference-free method ----------------------------------------------------------------
+
+/// Closed-form hand–eye rotation X = R_device_camera from photo pairs (i, j) of the same group
+/// (placement): A = R_world_device_i^T R_world_device_j, B = R_camera_board_i R_camera_board_j^T
+/// satisfy A X = X B, hence log(A) = X log(B) (Park & Martin, IEEE T-RA 10(5), 1994, eq. 10);
+/// X is the rotation minimising Σ ‖log A − X log B‖² over all pairs (Kabsch/Umeyama SVD), the
+/// pair weight being implicitly its rotation angle. OpenCV's calibrateHandEye solves the same
+/// for ONE fixed target; here pairs of several placements are pooled.
+Mat3 hand_eye_rotation(const std::vector<Mat3>& R_world_device, const std::vector<Mat3>& R_camera_board,
+                       const std::vector<std::size_t>& group);
+
+/// Chordal L2 mean of rotations: the rotation nearest (Frobenius) to their sum.
+Mat3 chordal_mean(const std::vector<Mat3>& rotations);
+
+struct ReferenceFreeOptions {
+  std::optional<Mat3> R_start;              // skip the closed-form start (still refined)
+  bool estimate_time_offset = true;
+  double time_offset_start_s = 0.0;         // used when δt is not estimated or unobservable
+  double time_offset_min_s = -0.2, time_offset_max_s = 0.2;  // grid-search bracket
+  double time_offset_step_s = 0.005;
+  double max_time_offset_sigma_s = 0.02;    // larger σ(δt): unobservable, δt fixed with a warning
+  double min_rate_deg_s = 0.5;              // every shot slower than this: δt not attempted
+  std::size_t min_photos_per_placement = 3;
+  double min_view_change_deg = 3.0;         // a placement whose photos differ less is "one pose"
+  double min_axis_spread_deg = 2.0;         // RMS relative rotation off the dominant axis
+  double default_tilt_sigma_deg = 0.5;      // track without covariance
+  double default_heading_sigma_deg = 2.0;
+  double default_pnp_sigma_deg = 0.1;       // photo without (positive definite) covariance
+  double sigma_floor_deg = 0.02;            // added in quadrature to every photo's noise
+  double huber_k = 3.0;                     // Huber threshold on the whitened residual norm
+  double outlier_chi2 = 16.27;              // χ²₃(0.999) on the robustly normalised residual
+  double min_outlier_deg = 0.1;             // and a residual angle above this (noise-free data)
+  int max_iterations = 100;
+};
+
+struct PhotoResidual {
+  std::size_t photo = 0;          // index into the input photos
+  std::string name, placement;
+  double angle_deg = 0.0;         // |log(R_world_device X R_camera_board R_world_board^T)|
+  double tilt_deg = 0.0;          // its horizontal (tilt) part
+  double heading_deg = 0.0;       // its vertical (heading) part, signed
+  double normalised = 0.0;        // whitened squared norm / variance factor (≈ χ²₃ for an inlier)
+  bool outlier = false;
+};
+
+struct PlacementAttitude {
+  std::string placement;
+  Mat3 R_world_board = Mat3::Identity();  // world frame of the track (ENU-magnetic by default)
+  std::size_t photos = 0;                 // used in the fit (outliers excluded)
+  double rms_deg = 0.0;                   // RMS residual angle of those photos
+};
+
+struct ReferenceFreeCalibration {
+  Mat3 R_device_camera = Mat3::Identity();
+  Mat3 covariance = Mat3::Zero();         // rad², device frame (R_true = exp(δ) R_est)
+  Mat3 R_device_camera_closed_form = Mat3::Identity();
+  double time_offset_s = 0.0;
+  double time_offset_sigma_s = std::numeric_limits<double>::quiet_NaN();  // NaN when not estimated
+  bool time_offset_estimated = false;
+  double time_offset_grid_s = 0.0;        // the grid-search start
+  double variance_factor = 1.0;           // χ²/dof of the whitened residuals (scales covariance)
+  std::vector<PhotoResidual> residuals;   // one per photo used (outliers included, flagged)
+  std::vector<std::size_t> outliers;      // indexes into the input photos
+  std::vector<PlacementAttitude> boards;
+  std::optional<AngleErrorTable> reference_check;  // when a board reference is given
+  std::vector<std::string> warnings;
+
+  /// 1σ per device axis (deg) from the covariance diagonal.
+  Vec3 rotation_sigma_deg() const;
+  /// The result as stored in a device profile (method "reference-free").
+  store::CameraImuCalibration to_profile() const;
+};
+
+/// Method B. Warnings (also in `diagnostics`) for photos outside the track (named), placements
+/// with too few photos or taken from one pose (left out), outliers, and an unobservable time
+/// offset (phone still at every shot). MeasurementError when no usable placement remains or the
+/// relative rotations are all about one axis (R_device_camera not observable). `reference`, when
+/// given, only checks the result (AngleErrorTable "reference-free").
+ReferenceFreeCalibration calibrate_reference_free(const std::vector<PhotoObservation>& photos,
+                                                  const orientation::OrientationTrack& track,
+                                                  const ReferenceFreeOptions& options, Diagnostics& diagnostics,
+                                                  const BoardReference* reference = nullptr);
+
+}  // namespace antpose::calibration
