@@ -1,6 +1,6 @@
 // antpose calibrate: per-device sensor calibration.
 //   antpose calibrate imu CAPTURE -o device.yaml [--sensors acc,gyro,mag] [--method thesis|full] [--force]
-//   antpose calibrate imu CAPTURE --device ID [--db PATH] [-o device.yaml] ...   (recorded in the device database)
+//   antpose calibrate imu CAPTURE --device ID|FILE [--db PATH] [-o device.yaml] ...   (stored with the device)
 //   antpose calibrate allan CAPTURE [--stream gyroscope] [--json OUT] [--plot OUT.svg]
 #include <filesystem>
 #include <optional>
@@ -12,8 +12,8 @@
 #include "antpose/calibration/allan.hpp"
 #include "antpose/calibration/calibrate_imu.hpp"
 #include "antpose/io/text_file.hpp"
-#include "antpose/store/device_db.hpp"
 #include "commands.hpp"
+#include "device_calibration.hpp"
 
 namespace antpose::cli {
 namespace {
@@ -25,68 +25,55 @@ struct ImuArgs {
   std::string method = "full";
   std::optional<double> gravity;
   bool force = false;
-  std::optional<std::string> device, db;  // record the run in the device database
+  DeviceOption device;
 };
 
-// calibrate imu --device ID: the device's current profile is the base, the run (settings, every
-// input file's SHA-256, residuals) is recorded; a failure is recorded as a failed run and leaves
-// the profile unchanged. -o, when also given, receives the whole new profile.
-void run_imu_device(const ImuArgs& args, const calibration::CalibrateImuOptions& options) {
-  // The database profile is the base here, so an existing -o file would be replaced, not merged.
+// calibrate imu --device ID|FILE: the device's current profile is the base (sections of sensors
+// not calibrated now are kept); only the imu section is this run's. -o, when also given,
+// receives the whole new profile.
+void run_imu_device(const ImuArgs& args, const calibration::CalibrateImuOptions& options,
+                    const store::DeviceRef& device) {
   if (!args.output.empty() && fs::exists(args.output) && !args.force)
-    throw InputError(args.output, "-o: exists; with --device the file receives the device's whole profile from the "
-                                  "database. Use --force to replace it, or another name");
-  store::DeviceDb db(store::DeviceDb::resolve_path(args.db ? std::optional<fs::path>(*args.db) : std::nullopt));
-  store::CalibrationRun run;
-  run.device_id = *args.device;
-  run.kind = "imu";
-  run.started_utc = store::utc_now();
-  run.settings = {{"sensors", args.sensors}, {"method", args.method}, {"capture", args.capture}};
-  if (args.gravity) run.settings["gravity_m_s2"] = *args.gravity;
-  store::DeviceProfile profile;
-  profile.id = *args.device;
-  if (db.has_device(profile.id)) profile = db.profile(profile.id);
+    throw InputError(args.output, "-o: exists; with --device the file receives the device's whole profile. Use "
+                                  "--force to replace it, or another name");
+  nlohmann::json settings = {{"sensors", args.sensors}, {"method", args.method}, {"capture", args.capture}};
+  if (args.gravity) settings["gravity_m_s2"] = *args.gravity;
   Diagnostics diagnostics;
   try {
-    run.inputs = store::to_json(store::hash_inputs(args.capture));
-    const Capture capture = read_capture(args.capture, diagnostics);
-    if (capture.kind != "imu-calibration")
-      diagnostics.warn(args.capture, 0, fmt::format("capture kind is '{}', not 'imu-calibration'", capture.kind));
-    const auto result = calibration::calibrate_imu(capture, options, diagnostics, args.capture, profile.imu);
-    store::DeviceProfile after = profile;
-    after.imu = result.calibration;
-    after.imu.device_id = after.id;
-    after.has_imu = true;
-    const auto& c = result.calibration;
-    run.residuals = {{"gravity_m_s2", result.gravity}, {"static_frames", result.frames.size()}};
-    if (c.acc_residual_rms_m_s2) run.residuals["acc_residual_rms_m_s2"] = *c.acc_residual_rms_m_s2;
-    if (c.gyro_residual_rms_deg) run.residuals["gyro_residual_rms_deg"] = *c.gyro_residual_rms_deg;
-    if (c.mag_residual_rel) run.residuals["mag_residual_rel"] = *c.mag_residual_rel;
-    if (c.mag_field_uT) run.residuals["mag_field_uT"] = *c.mag_field_uT;
-    if (!args.output.empty()) store::write_device_profile(after, args.output);
-    run.finished_utc = store::utc_now();
-    // Applied to the profile current at commit time: a camera calibration stored by another
-    // process meanwhile is kept; only the IMU section is this run's.
-    const auto id = db.record_run(run, [&](store::DeviceProfile current) {
-      YAML::Node document = YAML::Clone(current.imu.document);
-      if (!document.IsMap()) document = YAML::Node(YAML::NodeType::Map);
-      if (after.imu.document.IsMap() && after.imu.document["imu"]) document["imu"] = YAML::Clone(after.imu.document["imu"]);
-      current.imu = after.imu;
-      current.imu.document = document;
-      current.has_imu = true;
-      return current;
+    run_calibration(device, "imu", settings, {args.capture}, [&] {
+      const Capture capture = read_capture(args.capture, diagnostics);
+      if (capture.kind != "imu-calibration")
+        diagnostics.warn(args.capture, 0, fmt::format("capture kind is '{}', not 'imu-calibration'", capture.kind));
+      const auto result = calibration::calibrate_imu(capture, options, diagnostics, args.capture, device.profile.imu);
+      CalibrationOutcome outcome;
+      const auto& c = result.calibration;
+      outcome.residuals = {{"gravity_m_s2", result.gravity}, {"static_frames", result.frames.size()}};
+      if (c.acc_residual_rms_m_s2) outcome.residuals["acc_residual_rms_m_s2"] = *c.acc_residual_rms_m_s2;
+      if (c.gyro_residual_rms_deg) outcome.residuals["gyro_residual_rms_deg"] = *c.gyro_residual_rms_deg;
+      if (c.mag_residual_rel) outcome.residuals["mag_residual_rel"] = *c.mag_residual_rel;
+      if (c.mag_field_uT) outcome.residuals["mag_field_uT"] = *c.mag_field_uT;
+      outcome.apply = [imu = result.calibration](store::DeviceProfile& current) {
+        YAML::Node document = YAML::Clone(current.imu.document);
+        if (!document.IsMap()) document = YAML::Node(YAML::NodeType::Map);
+        if (imu.document.IsMap() && imu.document["imu"]) document["imu"] = YAML::Clone(imu.document["imu"]);
+        current.imu = imu;
+        current.imu.document = document;
+        current.imu.device_id = current.id;
+        current.has_imu = true;
+      };
+      print_warnings(diagnostics);
+      diagnostics = {};
+      fmt::print("IMU calibration of {} (method {})\n{}", args.capture, args.method, calibration::describe(result));
+      if (!args.output.empty()) {
+        store::DeviceProfile after = device.profile;
+        outcome.apply(after);
+        store::write_device_profile(after, args.output);
+        fmt::print("wrote {}\n", args.output);
+      }
+      return outcome;
     });
+  } catch (...) {
     print_warnings(diagnostics);
-    fmt::print("IMU calibration of {} (method {})\n{}recorded as run {} of device '{}' in {}\n", args.capture, args.method,
-               calibration::describe(result), id, profile.id, db.path().string());
-    if (!args.output.empty()) fmt::print("wrote {}\n", args.output);
-  } catch (const std::exception& e) {
-    print_warnings(diagnostics);
-    run.status = "failed";
-    run.message = e.what();
-    run.finished_utc = store::utc_now();
-    const auto id = db.record_run(run, profile);
-    fmt::print(stderr, "recorded failed run {} of device '{}'; its profile was not changed\n", id, profile.id);
     throw;
   }
 }
@@ -96,8 +83,8 @@ void run_imu(const ImuArgs& args) {
   calibration::parse_sensors(args.sensors, options);
   options.method = calibration::parse_method(args.method);
   options.gravity = args.gravity;
-  if (args.device) return run_imu_device(args, options);
-  if (args.output.empty()) throw InputError("-o", "no output given: pass -o device.yaml and/or --device ID");
+  if (const auto device = args.device.resolve()) return run_imu_device(args, options, *device);
+  if (args.output.empty()) throw InputError("-o", "no output given: pass -o device.yaml and/or --device ID|FILE");
   Diagnostics diagnostics;
   calibration::CalibrateImuResult result;
   try {
@@ -167,10 +154,7 @@ void add_calibrate_command(CLI::App& app) {
                                          "imu-calibration capture; writes the device YAML");
   imu->add_option("capture", imu_args->capture, "imu-calibration capture folder")->required();
   imu->add_option("-o,--output", imu_args->output, "device calibration YAML to write (required without --device)");
-  imu->add_option("--device", imu_args->device, "device id: start from its profile in the device database and record "
-                                                "the run there (docs/devices.md)");
-  imu->add_option("--db", imu_args->db, "device database (default: $ANTPOSE_DB, else "
-                                        "$XDG_DATA_HOME/antpose/devices.sqlite, else ~/.local/share/antpose/devices.sqlite)");
+  imu_args->device.add_to(*imu);
   imu->add_option("--sensors", imu_args->sensors, "comma-separated subset of acc,gyro,mag")->capture_default_str();
   imu->add_option("--method", imu_args->method, "thesis (normalization, bias, hard iron) or full (9-parameter models, "
                                                 "ellipsoid)")

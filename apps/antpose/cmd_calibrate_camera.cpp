@@ -1,6 +1,7 @@
 // antpose calibrate camera: intrinsic calibration from photos of a board.
 //   antpose calibrate camera CAPTURE [--config FILE] [--fix-aspect-ratio] [--zero-tangent]
-//       [--fix-principal-point] [--intrinsics-guess FILE] [--flip] -o camera.yaml [--force] [--json OUT]
+//       [--fix-principal-point] [--intrinsics-guess FILE] [--flip] [-o camera.yaml] [--force] [--json OUT]
+//       [--device ID|FILE [--db PATH]]
 // Command-line switches add to the config (they can only switch a constraint on).
 #include <filesystem>
 #include <string>
@@ -11,6 +12,7 @@
 #include "antpose/camera/calibrate_camera.hpp"
 #include "antpose/io/text_file.hpp"
 #include "commands.hpp"
+#include "device_calibration.hpp"
 
 namespace antpose::cli {
 namespace {
@@ -19,6 +21,7 @@ namespace fs = std::filesystem;
 struct CameraArgs {
   std::string capture, config, guess, output, json;
   bool fix_aspect_ratio = false, zero_tangent = false, fix_principal_point = false, flip = false, force = false;
+  DeviceOption device;
 };
 
 nlohmann::json to_json(const camera::CameraCalibrationResult& r) {
@@ -59,28 +62,55 @@ void run_camera(const CameraArgs& args) {
   settings.fix_principal_point = settings.fix_principal_point || args.fix_principal_point;
   settings.flip_vertical = settings.flip_vertical || args.flip;
   if (!args.guess.empty()) settings.intrinsics_guess = camera::read_camera_file(args.guess).intrinsics;
+  const auto device = args.device.resolve();
+  if (args.output.empty() && !device)
+    throw InputError("-o", "no output given: pass -o camera.yaml and/or --device ID|FILE");
   // Refuse an existing output before the (long) run rather than after it.
-  if (!args.force && fs::exists(args.output))
+  if (!args.output.empty() && !args.force && fs::exists(args.output))
     throw InputError(args.output, "exists already; pass --force to replace it");
 
-  camera::CameraCalibrationResult result;
+  nlohmann::json run_settings = {{"capture", args.capture},
+                                 {"fix_aspect_ratio", settings.fix_aspect_ratio},
+                                 {"zero_tangent", settings.zero_tangent},
+                                 {"fix_principal_point", settings.fix_principal_point},
+                                 {"flip_vertical", settings.flip_vertical},
+                                 {"distortion_coefficients", settings.distortion_coefficients}};
+  if (!args.config.empty()) run_settings["config"] = args.config;
+  std::vector<fs::path> inputs{args.capture};
+  if (!args.config.empty()) inputs.emplace_back(args.config);
   try {
-    result = camera::calibrate_camera(
-        fs::path(args.capture), settings, diagnostics,
-        [](const camera::CalibrationImage& im, std::size_t done, std::size_t total) {
-          fmt::print(stderr, "[{}/{}] {}: {}\n", done, total, im.image,
-                     im.points > 0 ? fmt::format("{} points", im.points) : im.reason);
-        });
+    run_calibration(device, "camera", run_settings, inputs, [&] {
+      const auto result = camera::calibrate_camera(
+          fs::path(args.capture), settings, diagnostics,
+          [](const camera::CalibrationImage& im, std::size_t done, std::size_t total) {
+            fmt::print(stderr, "[{}/{}] {}: {}\n", done, total, im.image,
+                       im.points > 0 ? fmt::format("{} points", im.points) : im.reason);
+          });
+      print_warnings(diagnostics);
+      diagnostics = {};
+      fmt::print("camera calibration of {} ({} {}x{})\n{}", args.capture, camera::to_string(result.board.type),
+                 result.board.cols, result.board.rows, camera::describe(result));
+      if (!args.output.empty()) {
+        camera::write_camera_file(args.output, result, args.force);
+        fmt::print("wrote {}\n", args.output);
+      }
+      if (!args.json.empty()) io::write_text_atomic(args.json, to_json(result).dump(2) + "\n");
+      CalibrationOutcome outcome;
+      outcome.residuals = {{"rms_px", result.rms_px},
+                           {"photos_used", result.used_count()},
+                           {"photos", result.images.size()},
+                           {"flags", result.flag_names}};
+      for (const auto& [image, reason] : result.rejected()) outcome.residuals["rejected"].push_back({image, reason});
+      const auto pc = camera::profile_camera(result);
+      outcome.apply = [pc](store::DeviceProfile& current) {
+        current.camera = store::CameraCalibrationInfo{pc.intrinsics, pc.rms_px, pc.principal_point_sigma_px};
+      };
+      return outcome;
+    });
   } catch (...) {
     print_warnings(diagnostics);
     throw;
   }
-  print_warnings(diagnostics);
-  fmt::print("camera calibration of {} ({} {}x{})\n{}", args.capture, camera::to_string(result.board.type),
-             result.board.cols, result.board.rows, camera::describe(result));
-  camera::write_camera_file(args.output, result, args.force);
-  fmt::print("wrote {}\n", args.output);
-  if (!args.json.empty()) io::write_text_atomic(args.json, to_json(result).dump(2) + "\n");
 }
 
 }  // namespace
@@ -98,7 +128,8 @@ void add_calibrate_camera_command(CLI::App& calibrate) {
                 "keep the principal point at the image centre (or the guess's)");
   cmd->add_option("--intrinsics-guess", args->guess, "camera YAML to start from (CALIB_USE_INTRINSIC_GUESS)");
   cmd->add_flag("--flip", args->flip, "flip the photos around the horizontal axis before detection");
-  cmd->add_option("-o,--output", args->output, "camera YAML to write (OpenCV FileStorage)")->required();
+  cmd->add_option("-o,--output", args->output, "camera YAML to write (OpenCV FileStorage; required without --device)");
+  args->device.add_to(*cmd);
   cmd->add_flag("--force", args->force, "replace an existing output file");
   cmd->add_option("--json", args->json, "also write the result as JSON");
   cmd->callback([args] { run_camera(*args); });

@@ -163,7 +163,7 @@ TEST_F(JointCapture, PhotosShowTheBoardWhereTheTruthProjectsIt) {
     const YAML::Node s = scene["shots"][i];
     const CameraPose pose{mat(s["R_world_camera"]), vec(s["p_world_camera_m"])};
     const auto& [R_wb, p_wb] = placements.at(s["placement"].as<std::string>());
-    std::vector<camera::Vec2> truth;
+    std::vector<Vec2> truth;
     for (const Vec3& p : board.object_points()) {
       const auto uv = project_world(K, pose, p_wb + R_wb * p);
       ASSERT_TRUE(uv.has_value());

@@ -1,4 +1,4 @@
-// antpose device ... and calibrate imu --device: end to end through the CLI.
+// antpose device ... and calibrate imu|camera --device: end to end through the CLI.
 #include <fmt/format.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -164,6 +164,47 @@ TEST(DeviceCli, CalibrateImuRecordsRunsAndFailureKeepsProfile) {
   r = test::run_cli(fmt::format("calibrate imu {}", cap.string()));
   EXPECT_EQ(r.status, 2);
   EXPECT_THAT(r.err, HasSubstr("--device"));
+}
+
+// calibrate camera --device: the intrinsics (with the principal point's σ) become the camera
+// section; a calibration that fails is a failed run and the profile keeps its camera.
+TEST(DeviceCli, CalibrateCameraStoresIntrinsicsAndFailureKeepsThem) {
+  test::TempDir dir;
+  const fs::path db_file = dir / "d.sqlite";
+  const std::string db = "--db " + db_file.string();
+  const auto chess = test::shared_path("data/camera/opencv-chessboard-9x6");
+  auto r = test::run_cli(fmt::format("calibrate camera '{}' --device cam1 {}", chess.string(), db));
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("recorded as run 1 of device 'cam1'"));
+  DeviceDb d(db_file);
+  auto p = d.profile("cam1");
+  ASSERT_TRUE(p.camera);
+  EXPECT_NEAR(p.camera->intrinsics.fx, 536.07, 0.1);
+  ASSERT_TRUE(p.camera->principal_point_sigma_px);
+  EXPECT_GT(p.camera->principal_point_sigma_px->x(), 0.0);
+  EXPECT_FALSE(p.has_imu);
+  const auto h = d.history("cam1");
+  ASSERT_EQ(h.size(), 1u);
+  EXPECT_EQ(h[0].kind, "camera");
+  EXPECT_NEAR(h[0].residuals["rms_px"].get<double>(), 0.4087, 1e-3);
+  EXPECT_EQ(h[0].residuals["photos_used"], 13);
+
+  // A config naming another board: no photo shows it, the run fails, the camera stays.
+  test::write_file(dir / "wrong.yaml", "board: {type: chessboard, cols: 7, rows: 5, square_m: 0.03}\n");
+  r = test::run_cli(fmt::format("calibrate camera '{}' --config '{}' --device cam1 {}", chess.string(),
+                                (dir / "wrong.yaml").string(), db));
+  EXPECT_EQ(r.status, 3) << r.out;
+  EXPECT_THAT(r.err, HasSubstr("no board found"));
+  EXPECT_THAT(r.err, HasSubstr("recorded failed run 2 of device 'cam1'"));
+  EXPECT_EQ(d.history("cam1").back().status, "failed");
+  p = d.profile("cam1");
+  ASSERT_TRUE(p.camera);
+  EXPECT_NEAR(p.camera->intrinsics.fx, 536.07, 0.1);
+
+  // Neither -o nor --device: refused before any work.
+  r = test::run_cli(fmt::format("calibrate camera '{}'", chess.string()));
+  EXPECT_EQ(r.status, 2);
+  EXPECT_THAT(r.err, HasSubstr("no output given: pass -o camera.yaml and/or --device ID|FILE"));
 }
 
 }  // namespace

@@ -15,6 +15,7 @@
 
 #include "antpose/calibration/least_squares.hpp"
 #include "antpose/camera/camera_model.hpp"
+#include "antpose/orientation/gyro_integration.hpp"
 
 namespace antpose::calibration {
 namespace {
@@ -34,21 +35,6 @@ std::string describe(const PhotoObservation& p, std::size_t index) {
 /// time-offset search: photos outside the span are rejected before).
 Mat3 device_rotation(const orientation::OrientationTrack& track, double t) {
   return track.at(std::clamp(t, track.t.front(), track.t.back())).q_world_device.toRotationMatrix();
-}
-
-/// Covariance (rad², world) of the track at t, or the defaults (tilt, tilt, heading).
-Mat3 device_covariance(const orientation::OrientationTrack& track, double t, double tilt_sigma, double heading_sigma) {
-  const auto s = track.at(std::clamp(t, track.t.front(), track.t.back()));
-  if (s.covariance && s.covariance->allFinite() && s.covariance->trace() > 0.0) return *s.covariance;
-  return Vec3(tilt_sigma * tilt_sigma, tilt_sigma * tilt_sigma, heading_sigma * heading_sigma).asDiagonal();
-}
-
-/// Angular velocity in the world frame (rad/s), Ṙ = [ω]× R, by a central difference over ±h.
-Vec3 world_rate(const orientation::OrientationTrack& track, double t, double h = 0.005) {
-  const double a = std::clamp(t - h, track.t.front(), track.t.back());
-  const double b = std::clamp(t + h, track.t.front(), track.t.back());
-  if (b <= a) return Vec3::Zero();
-  return log_so3(device_rotation(track, b) * device_rotation(track, a).transpose()) / (b - a);
 }
 
 Vec3 board_axis(BoardAxis axis) { return Vec3::Unit(static_cast<int>(axis)); }
@@ -394,6 +380,10 @@ Mat3 chordal_mean(const std::vector<Mat3>& rotations) {
   return nearest_rotation(sum);
 }
 
+Vec2 principal_point_rotation_sigma(const camera::CameraIntrinsics& intrinsics, const Vec2& principal_point_sigma_px) {
+  return {principal_point_sigma_px.y() / intrinsics.fy, principal_point_sigma_px.x() / intrinsics.fx};
+}
+
 Vec3 ReferenceFreeCalibration::rotation_sigma_deg() const {
   return covariance.diagonal().cwiseMax(0.0).cwiseSqrt() * (180.0 / std::numbers::pi);
 }
@@ -410,29 +400,45 @@ store::CameraImuCalibration ReferenceFreeCalibration::to_profile() const {
 
 namespace {
 
-/// Whitened world-frame residual of one photo:
-///   r = L⁻¹ log( exp(ω Δ) R_ref exp(x) X0 R_camera_board R_world_board0ᵀ exp(−b) ),  Δ = δt − δt_ref,
-/// with R_ref = R_world_device(t_shot + δt_ref) and ω its world-frame rate (so exp(ωΔ) R_ref is
-/// R_world_device(t_shot + δt) to first order; the caller re-linearises until Δ → 0), and
-/// L Lᵀ = Σ_device + R_world_camera Σ_camera R_world_cameraᵀ (+ floor).
-struct BoardConsistencyResidual {
-  Mat3 R_ref;
-  Vec3 omega_world;
+/// One placement's photos and the gyroscope integrated across them.
+struct Segment {
+  std::string placement;
+  std::vector<std::size_t> members;                // positions in FreeProblem::index
+  std::optional<orientation::GyroIntegration> gyro;  // device(t) → device(t0), current bias
+  Vec3 bias = Vec3::Zero();                        // accumulated bias correction (rad/s)
+  std::array<double, 3> db{0, 0, 0};               // its increment in the current linearisation
+  Mat3 B0 = Mat3::Identity();                      // R_gyro_board (gyro frame = device at t0)
+  std::array<double, 3> b{0, 0, 0};                // board perturbation, gyro frame
+  Mat3 board() const { return exp_so3(Vec3(b[0], b[1], b[2])) * B0; }
+};
+
+/// Whitened residual of one photo in its segment's gyroscope frame:
+///   r = L⁻¹ log( ΔR_ref exp(ω Δ) exp(J δb) exp(x) X0 R_camera_board R_gyro_board0ᵀ exp(−b) ),
+/// with ΔR_ref, J = ΔR(t_shot + δt_ref) and its bias Jacobian, ω the body rate there and
+/// Δ = δt − δt_ref (first order in Δ and δb; the caller re-integrates until both vanish).
+struct PreintegratedBoardResidual {
+  Mat3 R_ref, J;
+  Vec3 omega;
   double dt_ref;
-  Mat3 C;        // X0 R_camera_board R_world_board0ᵀ
-  Mat3 W;        // L⁻¹
+  Mat3 C;  // X0 R_camera_board R_gyro_board0ᵀ
+  Mat3 W;  // L⁻¹
 
   template <typename T>
-  bool operator()(const T* x, const T* b, const T* dt, T* residual) const {
+  bool operator()(const T* x, const T* b, const T* db, const T* dt, T* residual) const {
     using M3 = Eigen::Matrix<T, 3, 3>;
     const T delta = dt[0] - T(dt_ref);
-    const T w[3] = {T(omega_world.x()) * delta, T(omega_world.y()) * delta, T(omega_world.z()) * delta};
+    T w[3], jb[3];
+    for (int r = 0; r < 3; ++r) {
+      w[r] = T(omega[r]) * delta;
+      jb[r] = T(J(r, 0)) * db[0] + T(J(r, 1)) * db[1] + T(J(r, 2)) * db[2];
+    }
     const T minus_b[3] = {-b[0], -b[1], -b[2]};
-    M3 Rw, Rx, Rb;
+    M3 Rw, Rj, Rx, Rb;
     ceres::AngleAxisToRotationMatrix(w, Rw.data());
+    ceres::AngleAxisToRotationMatrix(jb, Rj.data());
     ceres::AngleAxisToRotationMatrix(x, Rx.data());
     ceres::AngleAxisToRotationMatrix(minus_b, Rb.data());
-    const M3 M = Rw * R_ref.cast<T>() * Rx * C.cast<T>() * Rb;
+    const M3 M = R_ref.cast<T>() * Rw * Rj * Rx * C.cast<T>() * Rb;
     T e[3];
     ceres::RotationMatrixToAngleAxis(M.data(), e);
     for (int r = 0; r < 3; ++r) residual[r] = T(W(r, 0)) * e[0] + T(W(r, 1)) * e[1] + T(W(r, 2)) * e[2];
@@ -440,44 +446,81 @@ struct BoardConsistencyResidual {
   }
 };
 
+/// Prior on a segment's total bias correction: (bias + δb) / σ_b.
+struct BiasPrior {
+  Vec3 bias;
+  double inv_sigma;
+  template <typename T>
+  bool operator()(const T* db, T* residual) const {
+    for (int r = 0; r < 3; ++r) residual[r] = (T(bias[r]) + db[r]) * T(inv_sigma);
+    return true;
+  }
+};
+
 struct FreeProblem {
   const std::vector<PhotoObservation>* photos = nullptr;
-  const orientation::OrientationTrack* track = nullptr;
+  const orientation::SensorSeries* gyroscope = nullptr;
   const ReferenceFreeOptions* options = nullptr;
   std::vector<std::size_t> index;  // used photos → input index
-  std::vector<std::size_t> group;  // used photo → placement
-  std::vector<std::string> placements;
+  std::vector<std::size_t> group;  // used photo → segment
+  std::vector<Segment> segments;
 
   Mat3 X0 = Mat3::Identity();
-  std::vector<Mat3> B0;            // R_world_board0 per placement
   double x[3] = {0, 0, 0};
-  std::vector<std::array<double, 3>> b;
   double dt = 0.0;
 
   Mat3 X() const { return exp_so3(Vec3(x[0], x[1], x[2])) * X0; }
-  Mat3 board(std::size_t p) const { return exp_so3(Vec3(b[p][0], b[p][1], b[p][2])) * B0[p]; }
+  const PhotoObservation& photo(std::size_t k) const { return (*photos)[index[k]]; }
 
-  Mat3 photo_covariance(std::size_t k, const Mat3& R_world_device) const {
+  /// Integration window of a segment: its shots plus the whole time-offset bracket.
+  void integrate(Segment& s) const {
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (std::size_t k : s.members) lo = std::min(lo, photo(k).t_shot), hi = std::max(hi, photo(k).t_shot);
+    s.gyro.emplace(*gyroscope, lo + std::min(options->time_offset_min_s, dt) - 0.05,
+                   hi + std::max(options->time_offset_max_s, dt) + 0.05, s.bias, options->gyro_trapezoid);
+  }
+
+  Mat3 device(std::size_t k, double offset) const { return segments[group[k]].gyro->at(photo(k).t_shot + offset).R; }
+
+  /// Noise of photo k's residual (rad², gyro frame): PnP, the gyroscope's angle random walk since
+  /// the segment start, and a floor.
+  Mat3 photo_covariance(std::size_t k) const {
     const auto& o = *options;
-    const auto& ph = (*photos)[index[k]];
+    const auto& ph = photo(k);
     Mat3 cov_c = ph.cov_R_camera_board;
     Eigen::SelfAdjointEigenSolver<Mat3> es(0.5 * (cov_c + cov_c.transpose()));
     if (!cov_c.allFinite() || es.eigenvalues().minCoeff() <= 0.0)
       cov_c = Mat3::Identity() * std::pow(deg2rad(o.default_pnp_sigma_deg), 2);
-    const Mat3 R_wc = R_world_device * X0;
-    return device_covariance(*track, ph.t_shot + dt, deg2rad(o.default_tilt_sigma_deg),
-                             deg2rad(o.default_heading_sigma_deg)) +
-           R_wc * cov_c * R_wc.transpose() + Mat3::Identity() * std::pow(deg2rad(o.sigma_floor_deg), 2);
+    const auto& g = *segments[group[k]].gyro;
+    const Mat3 R_gc = g.at(ph.t_shot + dt).R * X0;
+    const double walk = o.gyro_noise_density * o.gyro_noise_density * std::max(0.0, ph.t_shot + dt - g.t0());
+    return R_gc * cov_c * R_gc.transpose() +
+           Mat3::Identity() * (walk + std::pow(deg2rad(o.sigma_floor_deg), 2));
   }
 
-  /// World-frame residual rotation vector of photo k at the current estimate (exact time).
+  /// Residual rotation vector of photo k at the current estimate (gyro frame, exact time).
   Vec3 residual(std::size_t k) const {
-    const auto& ph = (*photos)[index[k]];
-    return log_so3(device_rotation(*track, ph.t_shot + dt) * X() * ph.R_camera_board * board(group[k]).transpose());
+    return log_so3(device(k, dt) * X() * photo(k).R_camera_board * segments[group[k]].board().transpose());
   }
 
-  /// Result of solve(): final (whitened) cost of the last linearisation, and — when asked —
-  /// the unscaled covariance of x (rad², device frame) and the variance of δt (s²).
+  /// Closed-form start at a time offset: hand–eye rotation from the gyroscope's relative rotations
+  /// and chordal board means; returns a truncated (2°) cost for the time-offset search.
+  double closed_form(double offset, Mat3& X, std::vector<Mat3>& boards) const {
+    const std::size_t n = index.size();
+    std::vector<Mat3> R_gd(n), R_cb(n);
+    for (std::size_t k = 0; k < n; ++k) R_gd[k] = device(k, offset), R_cb[k] = photo(k).R_camera_board;
+    X = options->R_start ? nearest_rotation(*options->R_start) : hand_eye_rotation(R_gd, R_cb, group);
+    std::vector<std::vector<Mat3>> per(segments.size());
+    for (std::size_t k = 0; k < n; ++k) per[group[k]].push_back(R_gd[k] * X * R_cb[k]);
+    boards.resize(segments.size());
+    for (std::size_t s = 0; s < segments.size(); ++s) boards[s] = chordal_mean(per[s]);
+    const double cap = deg2rad(2.0);
+    double cost = 0.0;
+    for (std::size_t k = 0; k < n; ++k)
+      cost += std::min(std::pow(rotation_distance(R_gd[k] * X * R_cb[k], boards[group[k]]), 2), cap * cap);
+    return cost;
+  }
+
   struct Solution {
     double cost = 0.0;
     std::size_t residuals = 0;
@@ -486,33 +529,41 @@ struct FreeProblem {
     double var_dt = kNaN;
   };
 
-  /// Solves with photos where `use[k]` (Huber loss when `robust`), re-linearising the time
-  /// offset until it moves less than 10 µs (at most 6 rounds).
+  /// Solves with photos where `use[k]` (Huber loss when `robust`); after each round the bias
+  /// increments are folded into the integration and δt re-linearised, until δt moves less than
+  /// 10 µs and the bias less than 1e-6 rad/s (at most 8 rounds).
   Solution solve(const std::vector<bool>& use, bool robust, bool free_dt, bool want_covariance) {
     Solution sol;
-    for (int round = 0; round < 6; ++round) {
+    const double inv_sigma_b = 1.0 / options->gyro_bias_sigma_rad_s;
+    for (int round = 0; round < 8; ++round) {
       const double dt_ref = dt;
       ceres::Problem problem;
       sol.residuals = 0;
       for (std::size_t k = 0; k < index.size(); ++k) {
         if (!use[k]) continue;
-        const auto& ph = (*photos)[index[k]];
-        const double t = ph.t_shot + dt_ref;
-        const Mat3 R_ref = device_rotation(*track, t);
-        const Mat3 cov = photo_covariance(k, R_ref);
-        const Mat3 W = Eigen::LLT<Mat3>(cov).matrixL().solve(Mat3::Identity());
-        const Mat3 C = X0 * ph.R_camera_board * B0[group[k]].transpose();
-        auto* cost = new ceres::AutoDiffCostFunction<BoardConsistencyResidual, 3, 3, 3, 1>(
-            new BoardConsistencyResidual{R_ref, world_rate(*track, t), dt_ref, C, W});
-        problem.AddResidualBlock(cost, robust ? new ceres::HuberLoss(options->huber_k) : nullptr, x, b[group[k]].data(),
-                                 &dt);
+        auto& seg = segments[group[k]];
+        const double t = photo(k).t_shot + dt_ref;
+        const auto s = seg.gyro->at(t);
+        const Mat3 W = Eigen::LLT<Mat3>(photo_covariance(k)).matrixL().solve(Mat3::Identity());
+        const Mat3 C = X0 * photo(k).R_camera_board * seg.B0.transpose();
+        auto* cost = new ceres::AutoDiffCostFunction<PreintegratedBoardResidual, 3, 3, 3, 3, 1>(
+            new PreintegratedBoardResidual{s.R, s.J, seg.gyro->rate(t), dt_ref, C, W});
+        problem.AddResidualBlock(cost, robust ? new ceres::HuberLoss(options->huber_k) : nullptr, x, seg.b.data(),
+                                 seg.db.data(), &dt);
         ++sol.residuals;
       }
+      for (auto& seg : segments)
+        if (problem.HasParameterBlock(seg.db.data()))
+          problem.AddResidualBlock(
+              new ceres::AutoDiffCostFunction<BiasPrior, 3, 3>(new BiasPrior{seg.bias, inv_sigma_b}), nullptr,
+              seg.db.data());
       if (!free_dt) problem.SetParameterBlockConstant(&dt);
       const auto summary = solve_levenberg_marquardt(problem, options->max_iterations, 1e-12);
       sol.cost = summary.final_cost;
       sol.converged = summary.termination_type == ceres::CONVERGENCE;
-      const bool settled = !free_dt || std::abs(dt - dt_ref) < 1e-5;
+      double bias_step = 0.0;
+      for (const auto& seg : segments) bias_step = std::max(bias_step, Vec3(seg.db[0], seg.db[1], seg.db[2]).norm());
+      const bool settled = (!free_dt || std::abs(dt - dt_ref) < 1e-5) && bias_step < 1e-6;
       if (settled && want_covariance) {
         ceres::Covariance::Options co;
         co.algorithm_type = ceres::DENSE_SVD;
@@ -528,6 +579,13 @@ struct FreeProblem {
         }
       }
       if (settled) break;
+      // Fold the increments in: new bias, re-integrated gyroscope; the board keeps its attitude
+      // at the first photo's instant to first order (the Jacobian moves ΔR, b absorbs the rest).
+      for (auto& seg : segments) {
+        seg.bias += Vec3(seg.db[0], seg.db[1], seg.db[2]);
+        seg.db = {0, 0, 0};
+        integrate(seg);
+      }
     }
     return sol;
   }
@@ -536,11 +594,15 @@ struct FreeProblem {
 }  // namespace
 
 ReferenceFreeCalibration calibrate_reference_free(const std::vector<PhotoObservation>& photos,
+                                                  const orientation::SensorSeries& gyroscope,
                                                   const orientation::OrientationTrack& track,
                                                   const ReferenceFreeOptions& options, Diagnostics& diagnostics,
                                                   const BoardReference* reference) {
   ReferenceFreeCalibration out;
   auto& warnings = out.warnings;
+  if (gyroscope.size() < 2) throw MeasurementError("camera–IMU calibration: the gyroscope stream has fewer than 2 samples");
+  if (!(options.gyro_bias_sigma_rad_s > 0.0))
+    throw std::invalid_argument("calibrate_reference_free: gyro_bias_sigma_rad_s must be positive");
   const auto usable = photos_in_track(photos, track, 0.0, diagnostics, &warnings);
 
   // Group by placement (order of first appearance) and drop placements that cannot help.
@@ -553,16 +615,15 @@ ReferenceFreeCalibration calibrate_reference_free(const std::vector<PhotoObserva
   }
   FreeProblem fp;
   fp.photos = &photos;
-  fp.track = &track;
+  fp.gyroscope = &gyroscope;
   fp.options = &options;
-  std::vector<std::string> dropped;
+  fp.dt = options.time_offset_start_s;
   for (const auto& name : names) {
     const auto& m = members[name];
     if (m.size() < options.min_photos_per_placement) {
       warn(diagnostics, warnings,
            fmt::format("placement '{}' has {} usable photo(s), at least {} are needed; left out", name, m.size(),
                        options.min_photos_per_placement));
-      dropped.push_back(name);
       continue;
     }
     double largest = 0.0;
@@ -574,16 +635,28 @@ ReferenceFreeCalibration calibrate_reference_free(const std::vector<PhotoObserva
            fmt::format("placement '{}': all {} photos were taken from one pose (largest relative rotation {:.2f}°, "
                        "need ≥ {}°): they cannot constrain R_device_camera (degenerate hand–eye); left out",
                        name, m.size(), rad2deg(largest), options.min_view_change_deg));
-      dropped.push_back(name);
       continue;
     }
+    Segment seg;
+    seg.placement = name;
     for (std::size_t i : m) {
+      seg.members.push_back(fp.index.size());
       fp.index.push_back(i);
-      fp.group.push_back(fp.placements.size());
+      fp.group.push_back(fp.segments.size());
     }
-    fp.placements.push_back(name);
+    fp.integrate(seg);
+    if (seg.gyro->longest_step_s() > options.max_gyro_gap_s) {
+      warn(diagnostics, warnings,
+           fmt::format("placement '{}': the gyroscope has a {:.3f} s gap at t = {:.3f} s between its photos, so the "
+                       "phone's rotation there is unknown; left out",
+                       name, seg.gyro->longest_step_s(), seg.gyro->longest_step_at()));
+      fp.index.resize(fp.index.size() - m.size());
+      fp.group.resize(fp.group.size() - m.size());
+      continue;
+    }
+    fp.segments.push_back(std::move(seg));
   }
-  if (fp.placements.empty())
+  if (fp.segments.empty())
     throw MeasurementError(fmt::format("camera–IMU calibration: no usable placement ({} photos given, {} inside the "
                                        "orientation track; see the warnings)",
                                        photos.size(), usable.size()));
@@ -612,8 +685,8 @@ ReferenceFreeCalibration calibrate_reference_free(const std::vector<PhotoObserva
   // Angular rates at the shots: without motion the time offset cannot be seen.
   bool free_dt = options.estimate_time_offset;
   double max_rate = 0.0;
-  for (std::size_t i : fp.index)
-    max_rate = std::max(max_rate, world_rate(track, photos[i].t_shot + options.time_offset_start_s).norm());
+  for (std::size_t k = 0; k < fp.index.size(); ++k)
+    max_rate = std::max(max_rate, fp.segments[fp.group[k]].gyro->rate(fp.photo(k).t_shot + fp.dt).norm());
   if (free_dt && rad2deg(max_rate) < options.min_rate_deg_s) {
     warn(diagnostics, warnings,
          fmt::format("time offset unobservable: the phone was still at every shot (largest rate {:.2f}°/s); δt fixed "
@@ -622,36 +695,20 @@ ReferenceFreeCalibration calibrate_reference_free(const std::vector<PhotoObserva
     free_dt = false;
   }
 
-  // Closed-form start at a given δt: hand–eye rotation, chordal board means, a truncated cost.
-  const std::size_t n = fp.index.size(), P = fp.placements.size();
-  std::vector<Mat3> R_cb(n);
-  for (std::size_t k = 0; k < n; ++k) R_cb[k] = photos[fp.index[k]].R_camera_board;
-  auto closed_form = [&](double dt, Mat3& X, std::vector<Mat3>& boards) {
-    std::vector<Mat3> R_wd(n);
-    for (std::size_t k = 0; k < n; ++k) R_wd[k] = device_rotation(track, photos[fp.index[k]].t_shot + dt);
-    X = options.R_start ? nearest_rotation(*options.R_start) : hand_eye_rotation(R_wd, R_cb, fp.group);
-    std::vector<std::vector<Mat3>> per(P);
-    for (std::size_t k = 0; k < n; ++k) per[fp.group[k]].push_back(R_wd[k] * X * R_cb[k]);
-    boards.resize(P);
-    for (std::size_t p = 0; p < P; ++p) boards[p] = chordal_mean(per[p]);
-    const double cap = deg2rad(2.0);
-    double cost = 0.0;
-    for (std::size_t k = 0; k < n; ++k)
-      cost += std::min(std::pow(rotation_distance(R_wd[k] * X * R_cb[k], boards[fp.group[k]]), 2), cap * cap);
-    return cost;
-  };
+  // Closed-form start and the time-offset grid search.
+  const std::size_t n = fp.index.size(), P = fp.segments.size();
   double dt0 = options.time_offset_start_s;
+  std::vector<Mat3> boards;
   if (free_dt) {
     if (!(options.time_offset_max_s > options.time_offset_min_s && options.time_offset_step_s > 0))
       throw std::invalid_argument("calibrate_reference_free: empty time-offset bracket");
     double best = std::numeric_limits<double>::infinity();
     Mat3 X;
-    std::vector<Mat3> boards;
     const int steps = static_cast<int>(
         std::floor((options.time_offset_max_s - options.time_offset_min_s) / options.time_offset_step_s + 1e-9));
     for (int s = 0; s <= steps; ++s) {
       const double dt = options.time_offset_min_s + s * options.time_offset_step_s;
-      const double c = closed_form(dt, X, boards);
+      const double c = fp.closed_form(dt, X, boards);
       if (c < best) best = c, dt0 = dt;
     }
   }
@@ -662,19 +719,17 @@ ReferenceFreeCalibration calibrate_reference_free(const std::vector<PhotoObserva
                      options.time_offset_max_s, dt0));
   out.time_offset_grid_s = dt0;
   fp.dt = dt0;
-  closed_form(dt0, fp.X0, fp.B0);
+  fp.closed_form(dt0, fp.X0, boards);
   out.R_device_camera_closed_form = fp.X0;
-  fp.b.assign(P, {0.0, 0.0, 0.0});
+  for (std::size_t s = 0; s < P; ++s) fp.segments[s].B0 = boards[s];
 
   // Pass 1: Huber loss; flag outliers on the robustly normalised whitened residual.
   std::vector<bool> use(n, true);
   fp.solve(use, true, free_dt, false);
   std::vector<double> chi2(n), angle(n);
   for (std::size_t k = 0; k < n; ++k) {
-    const auto& ph = photos[fp.index[k]];
-    const Mat3 cov = fp.photo_covariance(k, device_rotation(track, ph.t_shot + fp.dt));
     const Vec3 e = fp.residual(k);
-    chi2[k] = e.dot(cov.ldlt().solve(e));
+    chi2[k] = e.dot(fp.photo_covariance(k).ldlt().solve(e));
     angle[k] = e.norm();
   }
   std::vector<double> sorted = chi2;
@@ -691,12 +746,15 @@ ReferenceFreeCalibration calibrate_reference_free(const std::vector<PhotoObserva
     warn(diagnostics, warnings, "more than a third of the photos are outliers: check the board detection and the track");
 
   // Pass 2: least squares on the inliers, covariance from Ceres scaled by the residual variance.
+  // Parameters: x, and per segment a board attitude and a bias (the bias has its prior's 3 rows).
   const std::size_t params = 3 + 3 * P;
   auto final_solve = [&](bool with_dt) {
     const auto sol = fp.solve(use, false, with_dt, true);
     const double dof = 3.0 * static_cast<double>(sol.residuals) - static_cast<double>(params + (with_dt ? 1 : 0));
     out.variance_factor = dof > 0 ? 2.0 * sol.cost / dof : 1.0;
     if (sol.cov_x) out.covariance = *sol.cov_x * out.variance_factor;
+    const Vec3 bias_var(std::pow(options.camera_rotation_sigma_rad.x(), 2), std::pow(options.camera_rotation_sigma_rad.y(), 2), 0.0);
+    out.covariance += fp.X() * bias_var.asDiagonal() * fp.X().transpose();
     out.time_offset_estimated = with_dt;
     out.time_offset_sigma_s = with_dt ? std::sqrt(std::max(0.0, sol.var_dt * out.variance_factor)) : kNaN;
     if (!sol.converged)
@@ -719,28 +777,41 @@ ReferenceFreeCalibration calibrate_reference_free(const std::vector<PhotoObserva
 
   out.R_device_camera = fp.X();
   out.time_offset_s = fp.dt;
-  // Residuals (exact track time) and board attitudes.
+  // The boards in the world: chordal mean of what the orientation track implies at the inliers;
+  // a photo's disagreement with that mean is the track's error there (tilt, heading).
+  std::vector<std::vector<Mat3>> implied(P);
+  std::vector<Mat3> R_world_board_photo(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    R_world_board_photo[k] = device_rotation(track, fp.photo(k).t_shot + fp.dt) * out.R_device_camera *
+                             fp.photo(k).R_camera_board;
+    if (use[k]) implied[fp.group[k]].push_back(R_world_board_photo[k]);
+  }
+  std::vector<Mat3> R_world_board(P);
+  for (std::size_t s = 0; s < P; ++s)
+    R_world_board[s] = implied[s].empty() ? Mat3::Identity() : chordal_mean(implied[s]);
   std::vector<double> sum_sq(P, 0.0);
-  std::vector<std::size_t> count(P, 0);
   for (std::size_t k = 0; k < n; ++k) {
     const Vec3 e = fp.residual(k);
+    const Vec3 e_world = log_so3(R_world_board_photo[k] * R_world_board[fp.group[k]].transpose());
     PhotoResidual r;
     r.photo = fp.index[k];
     r.name = describe(photos[r.photo], r.photo);
     r.placement = photos[r.photo].placement;
     r.angle_deg = rad2deg(e.norm());
-    r.tilt_deg = rad2deg(e.head<2>().norm());
-    r.heading_deg = rad2deg(e.z());
-    const Mat3 cov = fp.photo_covariance(k, device_rotation(track, photos[r.photo].t_shot + fp.dt));
-    r.normalised = e.dot(cov.ldlt().solve(e)) / (out.variance_factor > 0 ? out.variance_factor : 1.0);
+    r.tilt_deg = rad2deg(e_world.head<2>().norm());
+    r.heading_deg = rad2deg(e_world.z());
+    r.normalised = e.dot(fp.photo_covariance(k).ldlt().solve(e)) / (out.variance_factor > 0 ? out.variance_factor : 1.0);
     r.outlier = !use[k];
     if (r.outlier) out.outliers.push_back(r.photo);
-    else sum_sq[fp.group[k]] += e.squaredNorm(), ++count[fp.group[k]];
+    else sum_sq[fp.group[k]] += e.squaredNorm();
     out.residuals.push_back(std::move(r));
   }
-  for (std::size_t p = 0; p < P; ++p)
-    out.boards.push_back({fp.placements[p], fp.board(p), count[p],
-                          count[p] ? rad2deg(std::sqrt(sum_sq[p] / static_cast<double>(count[p]))) : kNaN});
+  for (std::size_t s = 0; s < P; ++s) {
+    const auto& seg = fp.segments[s];
+    const std::size_t count = implied[s].size();
+    out.boards.push_back({seg.placement, R_world_board[s], count,
+                          count ? rad2deg(std::sqrt(sum_sq[s] / static_cast<double>(count))) : kNaN, seg.bias});
+  }
   if (reference)
     out.reference_check = reference_angle_errors(photos, *reference, track, out.R_device_camera, out.time_offset_s,
                                                  ThesisOptions{}, "reference-free");

@@ -16,14 +16,18 @@
 //    horizontal projection is short, so small tilts swing its azimuth (thesis eq. 5.13/5.14).
 //    w3 = 0 (default) drops those lines; a warning names a placement left without N line.
 // B. Reference-free (antpose): the board does not move within a placement, so every photo of
-//    placement p must give the same R_world_board_p. Unknowns X, every R_world_board_p and δt.
+//    placement p must show the same board attitude. The relative rotations of the phone between
+//    its photos come from the gyroscope alone, integrated across the placement with a bias
+//    correction estimated per placement (preintegration, orientation/gyro_integration.hpp):
+//    a filter's absolute attitude leans into the linear accelerations of the walk around the
+//    board, nearly constantly in the device frame, which would pass straight into X.
+//    Unknowns: X, δt, and per placement the board attitude in the gyro frame and the bias.
 //    Start: hand–eye rotation A X = X B on all photo pairs of a placement (Park & Martin 1994,
 //    rotation step, solved as an orthogonal Procrustes problem), board attitudes by chordal L2
 //    averaging (Hartley et al. 2013), δt by a grid search; then Ceres refines the whitened
-//    world-frame residuals log(R_world_device(t_i+δt) X R_camera_board_i R_world_board_p^T)
-//    under a Huber loss, flags outliers, and refits without them. Heading errors of the
-//    magnetometer that are common to a placement are absorbed by R_world_board_p (a rotation
-//    about the vertical on the left of (1)), so no per-placement heading nuisance is needed.
+//    residuals log(ΔR_p(t_i+δt; b_p) X R_camera_board_i R_gyro_board_pᵀ) under a Huber loss,
+//    flags outliers, and refits without them. The orientation track only places each board in
+//    the world (and checks it against board_reference.csv when given).
 #pragma once
 
 #include <cstddef>
@@ -149,8 +153,16 @@ struct ReferenceFreeOptions {
   std::size_t min_photos_per_placement = 3;
   double min_view_change_deg = 3.0;         // a placement whose photos differ less is "one pose"
   double min_axis_spread_deg = 2.0;         // RMS relative rotation off the dominant axis
-  double default_tilt_sigma_deg = 0.5;      // track without covariance
-  double default_heading_sigma_deg = 2.0;
+  /// Gyroscope sample convention of the estimators (OrientationOptions::gyro_trapezoid): δt then
+  /// includes the same lag as the orientation track used for measurements.
+  bool gyro_trapezoid = false;
+  double gyro_noise_density = 3e-4;         // rad/s/√Hz, angle random walk of the integration
+  double gyro_bias_sigma_rad_s = 0.0175;    // prior σ of each placement's bias correction (1°/s)
+  double max_gyro_gap_s = 0.1;              // a longer gyroscope gap leaves the placement out
+  /// 1σ of the rotation error that the intrinsics give every board pose alike (rad, about the
+  /// camera's x and y axes): a principal point off by δ turns each PnP pose by about δ/f, which
+  /// passes unseen into X. Added to the covariance; from principal_point_rotation_sigma().
+  Vec2 camera_rotation_sigma_rad = Vec2::Zero();
   double default_pnp_sigma_deg = 0.1;       // photo without (positive definite) covariance
   double sigma_floor_deg = 0.02;            // added in quadrature to every photo's noise
   double huber_k = 3.0;                     // Huber threshold on the whitened residual norm
@@ -162,9 +174,11 @@ struct ReferenceFreeOptions {
 struct PhotoResidual {
   std::size_t photo = 0;          // index into the input photos
   std::string name, placement;
-  double angle_deg = 0.0;         // |log(R_world_device X R_camera_board R_world_board^T)|
-  double tilt_deg = 0.0;          // its horizontal (tilt) part
-  double heading_deg = 0.0;       // its vertical (heading) part, signed
+  double angle_deg = 0.0;         // fit residual |log(ΔR X R_camera_board R_gyro_boardᵀ)|
+  // The photo's board attitude through the orientation track against the placement's mean
+  // (world frame): the track's error at this photo, horizontal (tilt) and vertical (heading, signed).
+  double tilt_deg = 0.0;
+  double heading_deg = 0.0;
   double normalised = 0.0;        // whitened squared norm / variance factor (≈ χ²₃ for an inlier)
   bool outlier = false;
 };
@@ -173,7 +187,8 @@ struct PlacementAttitude {
   std::string placement;
   Mat3 R_world_board = Mat3::Identity();  // world frame of the track (ENU-magnetic by default)
   std::size_t photos = 0;                 // used in the fit (outliers excluded)
-  double rms_deg = 0.0;                   // RMS residual angle of those photos
+  double rms_deg = 0.0;                   // RMS fit residual angle of those photos
+  Vec3 gyro_bias_rad_s = Vec3::Zero();    // bias correction estimated over this placement
 };
 
 struct ReferenceFreeCalibration {
@@ -197,12 +212,19 @@ struct ReferenceFreeCalibration {
   store::CameraImuCalibration to_profile() const;
 };
 
-/// Method B. Warnings (also in `diagnostics`) for photos outside the track (named), placements
-/// with too few photos or taken from one pose (left out), outliers, and an unobservable time
+/// (σ(cy)/fy, σ(cx)/fx): the rotation about the camera's x and y axes that a principal-point
+/// error gives every board pose (ReferenceFreeOptions::camera_rotation_sigma_rad).
+Vec2 principal_point_rotation_sigma(const camera::CameraIntrinsics& intrinsics, const Vec2& principal_point_sigma_px);
+
+/// Method B. `gyroscope`: the device-frame rates (rad/s) the track was estimated from, with the
+/// device's IMU calibration applied. Warnings (also in `diagnostics`) for photos outside the
+/// track (named), placements with too few photos, taken from one pose or broken by a gyroscope
+/// gap (left out), outliers, and an unobservable time
 /// offset (phone still at every shot). MeasurementError when no usable placement remains or the
 /// relative rotations are all about one axis (R_device_camera not observable). `reference`, when
 /// given, only checks the result (AngleErrorTable "reference-free").
 ReferenceFreeCalibration calibrate_reference_free(const std::vector<PhotoObservation>& photos,
+                                                  const orientation::SensorSeries& gyroscope,
                                                   const orientation::OrientationTrack& track,
                                                   const ReferenceFreeOptions& options, Diagnostics& diagnostics,
                                                   const BoardReference* reference = nullptr);

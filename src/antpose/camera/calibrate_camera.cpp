@@ -760,10 +760,18 @@ CameraFile read_camera_file(const fs::path& file) {
   if (const auto bad = c.intrinsics.invalid_reason()) throw InputError(file, "invalid intrinsics: " + *bad);
   if (const cv::FileNode e = in["avg_reprojection_error"]; !e.empty() && (e.isReal() || e.isInt()))
     c.rms_px = static_cast<double>(e);
+  if (const cv::FileNode n = in["camera_matrix_std_dev"]; !n.empty()) {
+    cv::Mat sd;
+    n >> sd;
+    if (sd.total() == 4 && sd.type() == CV_64F && sd.at<double>(2) >= 0 && sd.at<double>(3) >= 0)
+      c.principal_point_sigma_px = Vec2(sd.at<double>(2), sd.at<double>(3));
+  }
   return c;
 }
 
-ProfileCamera profile_camera(const CameraCalibrationResult& r) { return {r.intrinsics, r.rms_px}; }
+ProfileCamera profile_camera(const CameraCalibrationResult& r) {
+  return {r.intrinsics, r.rms_px, Vec2(r.sigma.cx, r.sigma.cy)};
+}
 
 std::string describe(const CameraCalibrationResult& r) {
   std::string s = fmt::format("{:<28} {:>6}  {}\n", "image", "points", "RMS px / reason");

@@ -157,7 +157,8 @@ void write_camera_file(const std::filesystem::path& file, const CameraCalibratio
 
 struct CameraFile {
   CameraIntrinsics intrinsics;
-  std::optional<double> rms_px;  // avg_reprojection_error
+  std::optional<double> rms_px;                   // avg_reprojection_error
+  std::optional<Vec2> principal_point_sigma_px;   // 1σ of cx, cy (camera_matrix_std_dev), when written
 };
 /// Reads a camera file of the tutorial sample / OpenCV samples / ours (camera_matrix,
 /// distortion_coefficients with 4, 5 or more entries — beyond 5 must be zero —, image_width,
@@ -168,6 +169,7 @@ CameraFile read_camera_file(const std::filesystem::path& file);
 struct ProfileCamera {
   CameraIntrinsics intrinsics;
   double rms_px = 0;
+  Vec2 principal_point_sigma_px = Vec2::Zero();  // 1σ of cx, cy
 };
 ProfileCamera profile_camera(const CameraCalibrationResult& result);
 

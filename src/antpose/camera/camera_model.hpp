@@ -20,7 +20,6 @@
 
 namespace antpose::camera {
 
-using Vec2 = Eigen::Vector2d;
 
 struct CameraIntrinsics {
   int width = 0, height = 0;  // px

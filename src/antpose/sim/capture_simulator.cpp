@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 
+#include "antpose/calibration/accelerometer.hpp"
 #include "antpose/geomag/wmm.hpp"
 #include "antpose/io/csv.hpp"
 #include "antpose/sim/board_texture.hpp"
@@ -436,7 +437,7 @@ SimulatedCapture simulate_capture(const CaptureScenario& sc, const fs::path& scr
         const double roll = deg2rad(uniform(rng, -20.0, 20.0));
         const Mat3 R0 = look_rotation(centre - c, -Vec3::UnitZ(), roll);
         // Turn the camera so that the ray through the target pixel passes through the centre.
-        const Vec3 ray = d.intrinsics.ray(camera::Vec2(fu * (d.intrinsics.width - 1), fv * (d.intrinsics.height - 1)));
+        const Vec3 ray = d.intrinsics.ray(Vec2(fu * (d.intrinsics.width - 1), fv * (d.intrinsics.height - 1)));
         const Mat3 R_world_camera = R0 * rotation_between(ray, Vec3::UnitZ());
         const CameraPose pose{R_world_camera, c};
         if (!board_in_view(d.intrinsics, pose, board, stand.R_world_board, stand.p_world_board, 0.5 * board.square_m,
@@ -592,6 +593,17 @@ std::string capture_device_yaml(const SimulatedDevice& d, const ImuSimulation& i
   YAML::Node ci;
   ci["R_device_camera"] = mat_yaml(d.R_device_camera);
   ci["mounting_error_deg"] = num(d.mounting_error_deg);
+  // What an IMU calibration can recover: it defines the device frame by the accelerometer's own
+  // axes, so the accelerometer's mounting rotation Q (R_device_calibrated) is invisible to it.
+  {
+    const auto& a = d.phone.accelerometer;
+    Mat3 T, Q;
+    Vec3 k;
+    calibration::canonical_accelerometer((a.misalignment * a.scale.asDiagonal()).inverse(), T, k, &Q);
+    ci["R_calibrated_camera"] = mat_yaml(Q.transpose() * d.R_device_camera);
+    ci["calibrated_frame"] = "the device frame as an IMU calibration defines it (x along the accelerometer's x axis, y "
+                             "in its xy plane): R_calibrated_camera = R_device_calibratedᵀ R_device_camera";
+  }
   ci["p_device_camera_m"] = vec_yaml(d.p_device_camera);
   ci["time_offset_s"] = num(d.time_offset_s);
   ci["time_offset_definition"] = "IMU-clock instant of a photo = shots.csv t + time_offset_s";

@@ -47,7 +47,7 @@ Texture Texture::from_image(const cv::Mat& reflectance, const Eigen::Matrix<doub
   return t;
 }
 
-std::optional<camera::Vec2> project_world(const camera::CameraIntrinsics& intrinsics, const CameraPose& pose,
+std::optional<Vec2> project_world(const camera::CameraIntrinsics& intrinsics, const CameraPose& pose,
                                           const Vec3& p_world) {
   return intrinsics.project(pose.R_world_camera.transpose() * (p_world - pose.p_world_camera));
 }
@@ -65,8 +65,8 @@ PhotoRenderer::PhotoRenderer(const camera::CameraIntrinsics& intrinsics, int sup
     for (int v = rows.start; v < rows.end; ++v) {
       auto* row = xy_.ptr<cv::Vec2f>(v);
       for (int u = 0; u < W; ++u) {
-        const camera::Vec2 d((u - intrinsics.cx) / intrinsics.fx, (v - intrinsics.cy) / intrinsics.fy);
-        const camera::Vec2 xy = intrinsics.has_distortion() ? intrinsics.undistort(d) : d;
+        const Vec2 d((u - intrinsics.cx) / intrinsics.fx, (v - intrinsics.cy) / intrinsics.fy);
+        const Vec2 xy = intrinsics.has_distortion() ? intrinsics.undistort(d) : d;
         row[u] = cv::Vec2f(static_cast<float>(xy.x()), static_cast<float>(xy.y()));
       }
     }

@@ -79,7 +79,7 @@ struct CameraPose {
 
 /// Pixel of a world point seen from `pose` (CameraIntrinsics::project in the camera frame);
 /// std::nullopt behind the camera.
-std::optional<camera::Vec2> project_world(const camera::CameraIntrinsics& intrinsics, const CameraPose& pose,
+std::optional<Vec2> project_world(const camera::CameraIntrinsics& intrinsics, const CameraPose& pose,
                                           const Vec3& p_world);
 
 /// Renders linear radiance images of a camera. Construction undistorts every pixel centre once

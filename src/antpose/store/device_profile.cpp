@@ -58,6 +58,13 @@ CameraCalibrationInfo parse_camera(const YAML::Node& cam, const fs::path& file) 
       k.distortion[i] = io::yaml_number(d[i], file, fmt::format("camera.distortion[{}]", i));
   }
   if (cam["rms_px"]) info.rms_px = non_negative(cam["rms_px"], file, "camera.rms_px");
+  if (const YAML::Node s = cam["principal_point_sigma_px"]) {
+    if (!s.IsSequence() || s.size() != 2)
+      throw InputError(file, line_of(s),
+                       fmt::format("camera.principal_point_sigma_px is {}, expected [sigma_cx, sigma_cy] in px", show(s)));
+    info.principal_point_sigma_px = Vec2(non_negative(s[0], file, "camera.principal_point_sigma_px[0]"),
+                                         non_negative(s[1], file, "camera.principal_point_sigma_px[1]"));
+  }
   if (const auto reason = k.invalid_reason())
     throw InputError(file, line_of(cam),
                      fmt::format("camera intrinsics are {}; expected a positive size and focal length and the principal "
@@ -157,6 +164,15 @@ std::string format_device_profile(const DeviceProfile& profile) {
     cam["distortion"] = dist;
     if (profile.camera->rms_px) cam["rms_px"] = io::format_number(*profile.camera->rms_px);
     else cam.remove("rms_px");
+    if (const auto& s = profile.camera->principal_point_sigma_px) {
+      YAML::Node n(YAML::NodeType::Sequence);
+      n.push_back(io::format_number(s->x()));
+      n.push_back(io::format_number(s->y()));
+      n.SetStyle(YAML::EmitterStyle::Flow);
+      cam["principal_point_sigma_px"] = n;
+    } else {
+      cam.remove("principal_point_sigma_px");
+    }
     d["camera"] = cam;
   } else {
     d.remove("camera");

@@ -12,6 +12,7 @@
 //     fx_px: ..  fy_px: ..  cx_px: ..  cy_px: ..
 //     distortion: [k1, k2, p1, p2, k3]
 //     rms_px: 0.41                              fit diagnostic
+//     principal_point_sigma_px: [0.4, 0.4]      1σ of cx, cy (optional)
 //   camera_imu:
 //     R_device_camera: [[..], [..], [..]]       rotates camera-frame vectors into the device frame
 //     rotation_sigma_deg: [sx, sy, sz]          1σ of the rotation error vector (device frame), optional
@@ -41,6 +42,7 @@ struct CameraImuCalibration {
 struct CameraCalibrationInfo {
   camera::CameraIntrinsics intrinsics;
   std::optional<double> rms_px;
+  std::optional<Vec2> principal_point_sigma_px;  // 1σ of cx, cy: bounds the rotation bias of every pose
 };
 
 struct DeviceProfile {
