@@ -38,7 +38,8 @@ YAML::Node yaml_section(const YAML::Node& parent, const char* key, const std::fi
 YAML::Node yaml_required(const YAML::Node& parent, const char* key, const std::filesystem::path& file,
                          const std::string& path);
 
-/// Flow-style sequences with round-trip digits.
+/// A number with round-trip digits, and flow-style sequences of them.
+YAML::Node yaml_scalar(double v);
 YAML::Node yaml_flow_vector(const Vec3& v);
 YAML::Node yaml_flow_matrix(const Mat3& m);
 

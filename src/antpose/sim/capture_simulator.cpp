@@ -14,6 +14,7 @@
 #include "antpose/calibration/accelerometer.hpp"
 #include "antpose/geomag/wmm.hpp"
 #include "antpose/io/csv.hpp"
+#include "antpose/io/yaml_util.hpp"
 #include "antpose/sim/board_texture.hpp"
 
 namespace antpose::sim {
@@ -59,18 +60,9 @@ Mat3 look_rotation(const Vec3& forward, const Vec3& down, double roll) {
   return R * rot_z(roll);
 }
 
-YAML::Node num(double v) { return YAML::Node(io::format_number(v)); }
-YAML::Node vec_yaml(const Vec3& v) {
-  YAML::Node n;
-  for (int i = 0; i < 3; ++i) n.push_back(io::format_number(v[i]));
-  n.SetStyle(YAML::EmitterStyle::Flow);
-  return n;
-}
-YAML::Node mat_yaml(const Mat3& M) {
-  YAML::Node n;
-  for (int i = 0; i < 3; ++i) n.push_back(vec_yaml(M.row(i).transpose()));
-  return n;
-}
+using io::yaml_flow_matrix;
+using io::yaml_flow_vector;
+YAML::Node num(double v) { return io::yaml_scalar(v); }
 std::string emit(const YAML::Node& node) {
   YAML::Emitter out;
   out << node;
@@ -591,7 +583,7 @@ std::string capture_device_yaml(const SimulatedDevice& d, const ImuSimulation& i
   cam["distortion"] = dist;
   root["camera"] = cam;
   YAML::Node ci;
-  ci["R_device_camera"] = mat_yaml(d.R_device_camera);
+  ci["R_device_camera"] = yaml_flow_matrix(d.R_device_camera);
   ci["mounting_error_deg"] = num(d.mounting_error_deg);
   // What an IMU calibration can recover: it defines the device frame by the accelerometer's own
   // axes, so the accelerometer's mounting rotation Q (R_device_calibrated) is invisible to it.
@@ -600,11 +592,11 @@ std::string capture_device_yaml(const SimulatedDevice& d, const ImuSimulation& i
     Mat3 T, Q;
     Vec3 k;
     calibration::canonical_accelerometer((a.misalignment * a.scale.asDiagonal()).inverse(), T, k, &Q);
-    ci["R_calibrated_camera"] = mat_yaml(Q.transpose() * d.R_device_camera);
+    ci["R_calibrated_camera"] = yaml_flow_matrix(Q.transpose() * d.R_device_camera);
     ci["calibrated_frame"] = "the device frame as an IMU calibration defines it (x along the accelerometer's x axis, y "
                              "in its xy plane): R_calibrated_camera = R_device_calibratedᵀ R_device_camera";
   }
-  ci["p_device_camera_m"] = vec_yaml(d.p_device_camera);
+  ci["p_device_camera_m"] = yaml_flow_vector(d.p_device_camera);
   ci["time_offset_s"] = num(d.time_offset_s);
   ci["time_offset_definition"] = "IMU-clock instant of a photo = shots.csv t + time_offset_s";
   root["camera_imu"] = ci;
@@ -639,8 +631,8 @@ std::string capture_scene_yaml(const SimulatedCapture& sim, const camera::BoardS
   for (const auto& pl : sim.placements) {
     YAML::Node n;
     n["name"] = pl.name;
-    n["R_world_board"] = mat_yaml(pl.R_world_board);
-    n["p_world_board_m"] = vec_yaml(pl.p_world_board);
+    n["R_world_board"] = yaml_flow_matrix(pl.R_world_board);
+    n["p_world_board_m"] = yaml_flow_vector(pl.p_world_board);
     double t0 = 0, t1 = 0;
     bool any = false;
     for (const auto& s : sim.shots)
@@ -659,8 +651,8 @@ std::string capture_scene_yaml(const SimulatedCapture& sim, const camera::BoardS
   for (const auto& p : sim.surfaces) {
     YAML::Node n;
     n["name"] = p.name;
-    n["R_world_plane"] = mat_yaml(p.R_world_patch);
-    n["p_world_plane_m"] = vec_yaml(p.p_world_patch);
+    n["R_world_plane"] = yaml_flow_matrix(p.R_world_patch);
+    n["p_world_plane_m"] = yaml_flow_vector(p.p_world_patch);
     YAML::Node lo, hi;
     lo.push_back(io::format_number(p.min_xy.x()));
     lo.push_back(io::format_number(p.min_xy.y()));
@@ -679,10 +671,10 @@ std::string capture_scene_yaml(const SimulatedCapture& sim, const camera::BoardS
     if (!s.placement.empty()) n["placement"] = s.placement;
     n["t_true"] = num(s.t_true);
     n["t"] = num(s.t_shot);
-    n["R_world_device"] = mat_yaml(s.R_world_device);
-    n["p_world_device_m"] = vec_yaml(s.p_world_device);
-    n["R_world_camera"] = mat_yaml(s.R_world_camera);
-    n["p_world_camera_m"] = vec_yaml(s.p_world_camera);
+    n["R_world_device"] = yaml_flow_matrix(s.R_world_device);
+    n["p_world_device_m"] = yaml_flow_vector(s.p_world_device);
+    n["R_world_camera"] = yaml_flow_matrix(s.R_world_camera);
+    n["p_world_camera_m"] = yaml_flow_vector(s.p_world_camera);
     n["angular_rate_deg_s"] = num(s.angular_rate_deg_s);
     root["shots"].push_back(n);
   }

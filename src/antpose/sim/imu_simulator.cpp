@@ -9,6 +9,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "antpose/io/csv.hpp"
+#include "antpose/io/yaml_util.hpp"
 
 namespace antpose::sim {
 
@@ -122,27 +123,16 @@ Stream inertial_stream(std::string name, const InertialSensorErrors& e, double d
   return Stream::vector3(std::move(name), t, y);
 }
 
-YAML::Node num(double v) { return YAML::Node(io::format_number(v)); }
-
-YAML::Node vec_yaml(const Vec3& v) {
-  YAML::Node n;
-  for (int i = 0; i < 3; ++i) n.push_back(io::format_number(v[i]));
-  n.SetStyle(YAML::EmitterStyle::Flow);
-  return n;
-}
-
-YAML::Node mat_yaml(const Mat3& M) {
-  YAML::Node n;
-  for (int i = 0; i < 3; ++i) n.push_back(vec_yaml(M.row(i).transpose()));
-  return n;
-}
+using io::yaml_flow_matrix;
+using io::yaml_flow_vector;
+YAML::Node num(double v) { return io::yaml_scalar(v); }
 
 YAML::Node inertial_yaml(const InertialSensorErrors& e, const char* unit) {
   YAML::Node n;
   n["unit"] = unit;
-  n["misalignment"] = mat_yaml(e.misalignment);
-  n["scale"] = vec_yaml(e.scale);
-  n["bias"] = vec_yaml(e.bias);
+  n["misalignment"] = yaml_flow_matrix(e.misalignment);
+  n["scale"] = yaml_flow_vector(e.scale);
+  n["bias"] = yaml_flow_vector(e.bias);
   n["noise_density"] = num(e.noise_density);
   n["bias_random_walk"] = num(e.bias_random_walk);
   n["rate_hz"] = num(e.rate_hz);
@@ -562,13 +552,13 @@ std::string device_yaml(const ImuSimulation& sim) {
   root["gyroscope"] = inertial_yaml(sim.phone.gyroscope, "rad/s");
   YAML::Node mag;
   mag["unit"] = "uT";
-  mag["hard_iron_uT"] = vec_yaml(sim.phone.magnetometer.hard_iron_uT);
-  mag["soft_iron"] = mat_yaml(sim.phone.magnetometer.soft_iron);
+  mag["hard_iron_uT"] = yaml_flow_vector(sim.phone.magnetometer.hard_iron_uT);
+  mag["soft_iron"] = yaml_flow_matrix(sim.phone.magnetometer.soft_iron);
   mag["noise_uT"] = num(sim.phone.magnetometer.noise_uT);
   mag["rate_hz"] = num(sim.phone.magnetometer.rate_hz);
   mag["rate_jitter_s"] = num(sim.phone.magnetometer.rate_jitter_s);
   root["magnetometer"] = mag;
-  root["field_world_uT"] = vec_yaml(sim.field_world_uT);
+  root["field_world_uT"] = yaml_flow_vector(sim.field_world_uT);
   root["gravity"] = num(sim.gravity);
   root["earth_rotation"] = sim.earth_rotation;
   YAML::Node dist(YAML::NodeType::Sequence);
@@ -576,7 +566,7 @@ std::string device_yaml(const ImuSimulation& sim) {
     YAML::Node n;
     n["t0"] = num(d.t0);
     n["t1"] = num(d.t1);
-    n["extra_world_uT"] = vec_yaml(d.extra_world_uT);
+    n["extra_world_uT"] = yaml_flow_vector(d.extra_world_uT);
     dist.push_back(n);
   }
   root["disturbances"] = dist;
@@ -587,7 +577,7 @@ std::string contact_scene_yaml(const ContactTruth& truth) {
   const AntennaAttitude att = attitude_from_rotation(truth.R_world_antenna);
   YAML::Node antenna;
   antenna["name"] = "antenna";
-  antenna["R_world_antenna"] = mat_yaml(truth.R_world_antenna);
+  antenna["R_world_antenna"] = yaml_flow_matrix(truth.R_world_antenna);
   if (att.azimuth) {
     antenna["azimuth_deg"] = num(rad2deg(*att.azimuth));
     antenna["magnetic_azimuth_deg"] = num(rad2deg(wrap_2pi(*att.azimuth - truth.declination)));
