@@ -1,0 +1,72 @@
+// Registering an antenna model without a good guess. Local ICP settles in mirror poses from 30°
+// away, and a panel is nearly a symmetric box. So hypotheses are enumerated with a gravity prior:
+// panels hang almost upright (downtilt ≤ ~15°, roll ≤ a few degrees), so the model's long axis
+// z_a is put along the scene's up direction, tilted by each of `downtilt_deg`, and turned about it
+// on a yaw grid. Each hypothesis is refined by a coarse then a fine ICP (scene → model: every
+// scene point has a counterpart on the complete model, not the reverse).
+//
+// Score of a hypothesis (lower is better), two parts:
+//   - residual: mean over scene points of min(d², τ²)/τ², d the distance to the model;
+//   - visibility (when the camera viewpoints are known): the fraction of model samples facing a
+//     viewpoint that have no scene point within τ. A flipped model shows surface towards the
+//     cameras (e.g. the bracket of the back plate) where the reconstruction saw none.
+// Front/back check: the best hypothesis whose boresight points more than 90° away from the
+// winner's is the runner-up; when its score is within `ambiguity_ratio` of the winner's, the
+// result is flagged ambiguous (say so rather than report a confident azimuth).
+#pragma once
+
+#include <vector>
+
+#include "antpose/registration/icp.hpp"
+
+namespace antpose::registration {
+
+struct GlobalStartOptions {
+  double yaw_step_deg = 15.0;
+  std::vector<double> downtilt_deg = {0.0, 10.0};
+  IcpOptions coarse = [] {
+    IcpOptions o;
+    o.method = IcpMethod::kPointToPlane;
+    o.max_correspondence_distance_m = 0.15;
+    o.max_iterations = 30;
+    o.transformation_epsilon = 1e-7;
+    return o;
+  }();
+  IcpOptions fine = [] {
+    IcpOptions o;
+    o.method = IcpMethod::kPointToPlane;
+    o.max_correspondence_distance_m = 0.03;
+    o.max_iterations = 50;
+    o.kernel = RobustKernel::kHuber;
+    o.kernel_scale = 0.005;
+    return o;
+  }();
+  double truncation_m = 0.02;      // τ
+  double ambiguity_ratio = 1.5;
+  std::vector<Vec3> viewpoints_scene;  // camera centres in the scene frame (optional)
+};
+
+struct Hypothesis {
+  double yaw_rad = 0.0, downtilt_rad = 0.0;  // of the start
+  Iso3 T_model_scene = Iso3::Identity();      // after refinement
+  double residual = 0.0, unseen = 0.0;        // the two score parts
+  double score() const { return residual + unseen; }
+};
+
+struct GlobalStartResult {
+  IcpResult fit;                      // the winner, refined with the fine options
+  std::vector<Hypothesis> hypotheses;  // all, best first
+  double front_back_ratio = 0.0;       // runner-up score / winner score (∞ without runner-up)
+  bool front_back_ambiguous = false;
+};
+
+/// `scene` (e.g. reconstructed points, board frame) and `model` (antenna frame, normals outward,
+/// prepared for options.fine.method), `up_scene` the unit up direction in the scene frame.
+/// std::invalid_argument for an empty cloud, a model without normals or a zero up vector.
+GlobalStartResult global_align(const PreparedCloud& scene, const PreparedCloud& model, const Vec3& up_scene,
+                               const GlobalStartOptions& options);
+
+/// The cloud reduced to one point per occupied voxel (the centroid, with the mean normal).
+PointCloud voxel_downsample(const PointCloud& cloud, double voxel_m);
+
+}  // namespace antpose::registration
