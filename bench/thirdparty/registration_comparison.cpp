@@ -33,6 +33,7 @@
 #include <tbb/global_control.h>
 #include <tbb/info.h>
 
+#include "antpose/model/mesh.hpp"
 #include "antpose/registration/icp.hpp"
 
 namespace {
@@ -46,21 +47,10 @@ struct Case {
   double max_distance;
 };
 
-PointCloud read_ply_points(const fs::path& file) {
-  std::ifstream in(file);
-  if (!in) throw std::runtime_error("cannot read " + file.string());
-  std::string line;
-  while (std::getline(in, line) && line != "end_header") {
-  }
-  PointCloud c;
-  double x, y, z;
-  while (in >> x >> y >> z) c.points.emplace_back(x, y, z);
-  return c;
-}
-
 // Uniform samples on the surface of an axis-aligned box centred at the origin, with outward
 // normals; `keep` selects faces by their normal.
-PointCloud box_surface(const Vec3& size, double spacing, std::mt19937_64& rng, const std::function<bool(const Vec3&)>& keep) {
+PointCloud box_surface(const Vec3& size, double spacing, std::mt19937_64& rng,
+                       const std::function<bool(const Vec3&)>& keep) {
   PointCloud c;
   std::uniform_real_distribution<double> u(-0.5, 0.5);
   for (int axis = 0; axis < 3; ++axis)
@@ -93,8 +83,8 @@ std::vector<Case> make_cases(const fs::path& shared) {
   std::vector<Case> cases;
   Case bunny;
   bunny.name = "bunny";
-  bunny.source = read_ply_points(shared / "data/pointclouds/pcl/bun0.ply");
-  bunny.target = read_ply_points(shared / "data/pointclouds/pcl/bun4.ply");
+  bunny.source = PointCloud{model::read_mesh(shared / "data/pointclouds/pcl/bun0.ply").vertices, {}};
+  bunny.target = PointCloud{model::read_mesh(shared / "data/pointclouds/pcl/bun4.ply").vertices, {}};
   Eigen::Matrix4d E;
   E << 0.8806, 0.036481287330389023, -0.4724, 0.03453, -0.02354, 0.9992, 0.03326, -0.001519, 0.4732, -0.01817, 0.8808,
       0.04116, 0, 0, 0, 1;
@@ -150,7 +140,8 @@ void errors(Run& r, const Case& c, const Eigen::Matrix4d& T) {
 
 pcl::PointCloud<pcl::PointXYZ>::Ptr to_pcl(const PointCloud& c) {
   auto out = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
-  for (const auto& p : c.points) out->push_back(pcl::PointXYZ(static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z())));
+  for (const auto& p : c.points)
+    out->push_back(pcl::PointXYZ(static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z())));
   return out;
 }
 
@@ -158,8 +149,10 @@ pcl::PointCloud<pcl::PointNormal>::Ptr to_pcl_normals(const PointCloud& c, const
   auto out = pcl::make_shared<pcl::PointCloud<pcl::PointNormal>>();
   for (std::size_t i = 0; i < c.size(); ++i) {
     pcl::PointNormal p;
-    p.x = static_cast<float>(c.points[i].x()), p.y = static_cast<float>(c.points[i].y()), p.z = static_cast<float>(c.points[i].z());
-    p.normal_x = static_cast<float>(normals[i].x()), p.normal_y = static_cast<float>(normals[i].y()), p.normal_z = static_cast<float>(normals[i].z());
+    p.x = static_cast<float>(c.points[i].x()), p.y = static_cast<float>(c.points[i].y()),
+    p.z = static_cast<float>(c.points[i].z());
+    p.normal_x = static_cast<float>(normals[i].x()), p.normal_y = static_cast<float>(normals[i].y()),
+    p.normal_z = static_cast<float>(normals[i].z());
     out->push_back(p);
   }
   return out;
@@ -213,7 +206,9 @@ std::vector<Run> run_case(const Case& c, int repeats) {
         T = icp.getFinalTransformation();
       } else if (method == registration::IcpMethod::kPointToPlane) {
         pcl::IterativeClosestPointWithNormals<pcl::PointNormal, pcl::PointNormal> icp;
-        icp.setInputSource(to_pcl_normals(c.source, source.cloud.has_normals() ? source.cloud.normals : std::vector<Vec3>(c.source.size(), Vec3::UnitZ())));
+        icp.setInputSource(to_pcl_normals(c.source, source.cloud.has_normals()
+                                                        ? source.cloud.normals
+                                                        : std::vector<Vec3>(c.source.size(), Vec3::UnitZ())));
         icp.setInputTarget(to_pcl_normals(c.target, target.cloud.normals));
         icp.setMaxCorrespondenceDistance(c.max_distance);
         icp.setMaximumIterations(50);
@@ -242,7 +237,8 @@ std::vector<Run> run_case(const Case& c, int repeats) {
       Run r{"open3d", name};
       namespace reg = open3d::pipelines::registration;
       const auto src = to_o3d(c.source, nullptr);
-      const auto dst = to_o3d(c.target, method == registration::IcpMethod::kPointToPoint ? nullptr : &target.cloud.normals);
+      const auto dst =
+          to_o3d(c.target, method == registration::IcpMethod::kPointToPoint ? nullptr : &target.cloud.normals);
       const reg::ICPConvergenceCriteria criteria(1e-6, 1e-6, 50);
       reg::RegistrationResult res;
       if (method == registration::IcpMethod::kGeneralized) {
@@ -252,11 +248,13 @@ std::vector<Run> run_case(const Case& c, int repeats) {
         });
       } else if (method == registration::IcpMethod::kPointToPlane) {
         r.seconds = median_seconds(repeats, [&] {
-          res = reg::RegistrationICP(src, dst, c.max_distance, c.T_start.matrix(), reg::TransformationEstimationPointToPlane(), criteria);
+          res = reg::RegistrationICP(src, dst, c.max_distance, c.T_start.matrix(),
+                                     reg::TransformationEstimationPointToPlane(), criteria);
         });
       } else {
         r.seconds = median_seconds(repeats, [&] {
-          res = reg::RegistrationICP(src, dst, c.max_distance, c.T_start.matrix(), reg::TransformationEstimationPointToPoint(), criteria);
+          res = reg::RegistrationICP(src, dst, c.max_distance, c.T_start.matrix(),
+                                     reg::TransformationEstimationPointToPoint(), criteria);
         });
       }
       errors(r, c, res.transformation_);
@@ -274,9 +272,12 @@ int main(int argc, char** argv) {
   int repeats = 9;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
-    if (a == "--json" && i + 1 < argc) json_out = argv[++i];
-    else if (a == "--repeats" && i + 1 < argc) repeats = std::max(1, std::atoi(argv[++i]));
-    else shared = a;
+    if (a == "--json" && i + 1 < argc)
+      json_out = argv[++i];
+    else if (a == "--repeats" && i + 1 < argc)
+      repeats = std::max(1, std::atoi(argv[++i]));
+    else
+      shared = a;
   }
   if (!fs::exists(shared / "data/pointclouds/pcl/bun0.ply")) {
     std::fprintf(stderr, "error: %s: no data/pointclouds/pcl/bun0.ply (pass the shared folder)\n", shared.c_str());
@@ -287,8 +288,8 @@ int main(int argc, char** argv) {
   nlohmann::json j;
   for (const auto& c : make_cases(shared)) {
     const auto runs = run_case(c, repeats);
-    fmt::print("\n{}: {} source / {} target points, start {:.2f}° and {:.1f} mm from the truth\n", c.name, c.source.size(),
-               c.target.size(), rad2deg(rotation_angle((c.T_start * c.T_truth.inverse()).linear())),
+    fmt::print("\n{}: {} source / {} target points, start {:.2f}° and {:.1f} mm from the truth\n", c.name,
+               c.source.size(), c.target.size(), rad2deg(rotation_angle((c.T_start * c.T_truth.inverse()).linear())),
                1e3 * (c.T_start * c.T_truth.inverse()).translation().norm());
     fmt::print("{:<16} {:<8} {:>7} {:>11} {:>12} {:>12} {:>14}\n", "method", "library", "threads", "time ms",
                "rot err °", "trans err mm", "time / antpose");
@@ -298,9 +299,13 @@ int main(int argc, char** argv) {
       });
       fmt::print("{:<16} {:<8} {:>7} {:>11.3f} {:>12.4f} {:>12.3f} {:>14.2f}\n", r.method, r.library, r.threads,
                  1e3 * r.seconds, r.rotation_error_deg, 1e3 * r.translation_error_m, r.seconds / base->seconds);
-      j[c.name].push_back({{"library", r.library}, {"method", r.method}, {"threads", r.threads},
-                           {"seconds", r.seconds}, {"rotation_error_deg", r.rotation_error_deg},
-                           {"translation_error_m", r.translation_error_m}, {"time_ratio_to_antpose", r.seconds / base->seconds}});
+      j[c.name].push_back({{"library", r.library},
+                           {"method", r.method},
+                           {"threads", r.threads},
+                           {"seconds", r.seconds},
+                           {"rotation_error_deg", r.rotation_error_deg},
+                           {"translation_error_m", r.translation_error_m},
+                           {"time_ratio_to_antpose", r.seconds / base->seconds}});
     }
   }
   if (!json_out.empty()) std::ofstream(json_out) << j.dump(2) << "\n";

@@ -2,30 +2,20 @@
 
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <random>
-#include <sstream>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "antpose/model/mesh.hpp"
 #include "antpose/registration/local_geometry.hpp"
 #include "support/test_support.hpp"
 
 namespace antpose::registration {
 namespace {
 
-// The x y z vertices of an ASCII point PLY (the PCL bunny views).
-PointCloud read_points(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  std::string line;
-  while (std::getline(in, line) && line != "end_header") {
-  }
-  PointCloud c;
-  double x, y, z;
-  while (in >> x >> y >> z) c.points.emplace_back(x, y, z);
-  return c;
-}
+// The PCL bunny views (point-only PLY).
+PointCloud read_points(const std::filesystem::path& file) { return {model::read_mesh(file).vertices, {}}; }
 
 Iso3 pose(const Vec3& rotation_vector, const Vec3& t) {
   Iso3 T = Iso3::Identity();
@@ -46,8 +36,8 @@ TEST(Icp, PointToPointReproducesPclBunnyTransform) {
   const auto r = align(source, target, Iso3::Identity(), o);
   Eigen::Matrix4d expected;
   expected << 0.8806, 0.036481287330389023, -0.4724, 0.03453,  //
-      -0.02354, 0.9992, 0.03326, -0.001519,                     //
-      0.4732, -0.01817, 0.8808, 0.04116,                        //
+      -0.02354, 0.9992, 0.03326, -0.001519,                    //
+      0.4732, -0.01817, 0.8808, 0.04116,                       //
       0, 0, 0, 1;
   const Eigen::Matrix4d T = r.T_target_source.matrix();
   double worst = 0.0;

@@ -27,6 +27,33 @@ Vec3 centroid(const std::vector<Vec3>& points) {
   return c / static_cast<double>(points.size());
 }
 
+/// Which points a camera at `viewpoint` sees: those facing it that are nearest in their viewing
+/// direction (a z-buffer of splatted points: bins of `bin_m` at the cloud's distance, a point
+/// hidden when another in its bin is more than `depth_tolerance_m` nearer).
+std::vector<bool> visible_from(const std::vector<Vec3>& points, const std::vector<Vec3>& normals, const Vec3& viewpoint,
+                               double bin_m, double depth_tolerance_m) {
+  const std::size_t n = points.size();
+  std::vector<bool> visible(n, false);
+  const Vec3 axis = (centroid(points) - viewpoint).normalized();
+  const Vec3 u = axis.unitOrthogonal(), v = axis.cross(u);
+  const double bin_rad = bin_m / std::max((centroid(points) - viewpoint).norm(), 1e-6);
+  std::map<std::pair<long, long>, double> nearest;
+  std::vector<std::pair<long, long>> key(n);
+  std::vector<double> range(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3 d = points[i] - viewpoint;
+    range[i] = d.norm();
+    if (normals[i].dot(-d) <= 0.0 || d.dot(axis) <= 0.0) continue;  // facing away, or behind the camera
+    key[i] = {std::lround(d.dot(u) / d.dot(axis) / bin_rad), std::lround(d.dot(v) / d.dot(axis) / bin_rad)};
+    auto [it, fresh] = nearest.emplace(key[i], range[i]);
+    if (!fresh) it->second = std::min(it->second, range[i]);
+    visible[i] = true;
+  }
+  for (std::size_t i = 0; i < n; ++i)
+    if (visible[i]) visible[i] = range[i] <= nearest[key[i]] + depth_tolerance_m;
+  return visible;
+}
+
 /// The two score parts of a pose (see the header).
 std::pair<double, double> score(const PreparedCloud& scene, const PreparedCloud& model, const Iso3& T_model_scene,
                                 const GlobalStartOptions& o) {
@@ -40,18 +67,21 @@ std::pair<double, double> score(const PreparedCloud& scene, const PreparedCloud&
   }
   residual /= static_cast<double>(scene.cloud.size());
   if (o.viewpoints_scene.empty()) return {residual, 0.0};
+  // The model in the scene frame, and which of its samples some camera would have seen.
   const Iso3 T_scene_model = T_model_scene.inverse();
+  const PointCloud m = transformed(model.cloud, T_scene_model);
+  std::vector<bool> seen(m.size(), false);
+  for (const auto& viewpoint : o.viewpoints_scene) {
+    const auto v = visible_from(m.points, m.normals, viewpoint, 2.0 * o.truncation_m, 2.0 * o.truncation_m);
+    for (std::size_t i = 0; i < m.size(); ++i) seen[i] = seen[i] || v[i];
+  }
   std::size_t facing = 0, missing = 0;
-  for (std::size_t i = 0; i < model.cloud.size(); ++i) {
-    const Vec3 p = T_scene_model * model.cloud.points[i];
-    const Vec3 n = T_scene_model.linear() * model.cloud.normals[i];
-    const bool seen = std::any_of(o.viewpoints_scene.begin(), o.viewpoints_scene.end(),
-                                  [&](const Vec3& v) { return n.dot((v - p).normalized()) > 0.2; });
-    if (!seen) continue;
+  for (std::size_t i = 0; i < m.size(); ++i) {
+    if (!seen[i]) continue;
     ++facing;
     std::size_t j;
     double d2;
-    if (!scene.tree.nearest(p, j, d2) || d2 > tau2) ++missing;
+    if (!scene.tree.nearest(m.points[i], j, d2) || d2 > tau2) ++missing;
   }
   return {residual, facing ? static_cast<double>(missing) / static_cast<double>(facing) : 0.0};
 }
@@ -91,6 +121,10 @@ GlobalStartResult global_align(const PreparedCloud& scene, const PreparedCloud& 
     throw std::invalid_argument("global_align: empty hypothesis grid");
   const Mat3 R_scene_upright = rotation_to_up(up_scene.normalized());
   const Vec3 c_scene = centroid(scene.cloud.points), c_model = centroid(model.cloud.points);
+  const PreparedCloud scene_coarse = prepare(voxel_downsample(scene.cloud, o.coarse_voxel_m), o.coarse);
+  const PreparedCloud model_coarse = prepare(voxel_downsample(model.cloud, o.coarse_voxel_m), o.coarse);
+  IcpOptions medium = o.coarse;
+  medium.max_correspondence_distance_m = std::max(o.fine.max_correspondence_distance_m, 2.0 * o.coarse_voxel_m);
 
   std::vector<Hypothesis> hypotheses;
   const int yaws = static_cast<int>(std::ceil(360.0 / o.yaw_step_deg - 1e-9));
@@ -106,30 +140,36 @@ GlobalStartResult global_align(const PreparedCloud& scene, const PreparedCloud& 
   tbb::parallel_for(std::size_t{0}, hypotheses.size(), [&](std::size_t i) {
     auto& h = hypotheses[i];
     // R_scene_model: upright, turned by yaw about up, tilted down about the model's x axis.
-    const Mat3 R_scene_model = R_scene_upright * exp_so3(Vec3::UnitZ() * h.yaw_rad) *
-                               exp_so3(Vec3::UnitX() * -h.downtilt_rad);
+    const Mat3 R_scene_model =
+        R_scene_upright * exp_so3(Vec3::UnitZ() * h.yaw_rad) * exp_so3(Vec3::UnitX() * -h.downtilt_rad);
     Iso3 T_model_scene = Iso3::Identity();
     T_model_scene.linear() = R_scene_model.transpose();
     T_model_scene.translation() = c_model - R_scene_model.transpose() * c_scene;
-    T_model_scene = align(scene, model, T_model_scene, o.coarse).T_target_source;
-    h.T_model_scene = align(scene, model, T_model_scene, o.fine).T_target_source;
-    std::tie(h.residual, h.unseen) = score(scene, model, h.T_model_scene, o);
+    T_model_scene = align(scene_coarse, model_coarse, T_model_scene, o.coarse).T_target_source;
+    h.T_model_scene = align(scene_coarse, model_coarse, T_model_scene, medium).T_target_source;
+    std::tie(h.residual, h.unseen) = score(scene_coarse, model_coarse, h.T_model_scene, o);
   });
   std::sort(hypotheses.begin(), hypotheses.end(),
             [](const Hypothesis& a, const Hypothesis& b) { return a.score() < b.score(); });
 
+  // The best hypothesis and its best rival facing the other way, on the full clouds.
+  auto refine = [&](Hypothesis h) {
+    h.T_model_scene = align(scene, model, h.T_model_scene, o.fine).T_target_source;
+    std::tie(h.residual, h.unseen) = score(scene, model, h.T_model_scene, o);
+    return h;
+  };
+  auto boresight = [](const Hypothesis& h) { return Vec3(h.T_model_scene.linear().transpose() * Vec3::UnitY()); };
   GlobalStartResult out;
-  const Hypothesis& best = hypotheses.front();
-  out.fit = align(scene, model, best.T_model_scene, o.fine);
-  // Runner-up: the best hypothesis whose boresight (model y axis) points the other way.
-  const Vec3 b_best = best.T_model_scene.linear().transpose() * Vec3::UnitY();
-  out.front_back_ratio = std::numeric_limits<double>::infinity();
-  for (const auto& h : hypotheses)
-    if ((h.T_model_scene.linear().transpose() * Vec3::UnitY()).dot(b_best) < 0.0) {
-      out.front_back_ratio = h.score() / std::max(best.score(), 1e-12);
-      break;
-    }
-  out.front_back_ambiguous = out.front_back_ratio < o.ambiguity_ratio;
+  out.winner = refine(hypotheses.front());
+  const auto rival = std::find_if(hypotheses.begin(), hypotheses.end(), [&](const Hypothesis& h) {
+    return boresight(h).dot(boresight(hypotheses.front())) < 0.0;
+  });
+  out.rival.residual = std::numeric_limits<double>::infinity();
+  if (rival != hypotheses.end()) out.rival = refine(*rival);
+  if (out.rival.score() < out.winner.score()) std::swap(out.winner, out.rival);
+  out.fit = align(scene, model, out.winner.T_model_scene, o.fine);
+  out.front_back_margin = out.rival.score() - out.winner.score();
+  out.front_back_ambiguous = out.front_back_margin < o.ambiguity_margin;
   out.hypotheses = std::move(hypotheses);
   return out;
 }

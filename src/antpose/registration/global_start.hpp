@@ -2,8 +2,9 @@
 // away, and a panel is nearly a symmetric box. So hypotheses are enumerated with a gravity prior:
 // panels hang almost upright (downtilt ≤ ~15°, roll ≤ a few degrees), so the model's long axis
 // z_a is put along the scene's up direction, tilted by each of `downtilt_deg`, and turned about it
-// on a yaw grid. Each hypothesis is refined by a coarse then a fine ICP (scene → model: every
-// scene point has a counterpart on the complete model, not the reverse).
+// on a yaw grid. Each hypothesis is refined by ICP on voxel-downsampled clouds (scene → model:
+// every scene point has a counterpart on the complete model, not the reverse) and scored; the
+// best one and its best rival facing the other way are then refined on the full clouds.
 //
 // Score of a hypothesis (lower is better), two parts:
 //   - residual: mean over scene points of min(d², τ²)/τ², d the distance to the model;
@@ -11,8 +12,10 @@
 //     viewpoint that have no scene point within τ. A flipped model shows surface towards the
 //     cameras (e.g. the bracket of the back plate) where the reconstruction saw none.
 // Front/back check: the best hypothesis whose boresight points more than 90° away from the
-// winner's is the runner-up; when its score is within `ambiguity_ratio` of the winner's, the
-// result is flagged ambiguous (say so rather than report a confident azimuth).
+// winner's is the rival. Their score difference is the evidence: e.g. 0.05 means 5 % more of the
+// camera-facing model surface lacks scene support (or the equivalent in residuals). When it is
+// below `ambiguity_margin` the result is flagged ambiguous (say so rather than report a
+// confident azimuth). A ratio would not do: the winner's own score is set by the sampling.
 #pragma once
 
 #include <vector>
@@ -23,6 +26,7 @@ namespace antpose::registration {
 
 struct GlobalStartOptions {
   double yaw_step_deg = 15.0;
+  double coarse_voxel_m = 0.02;  // hypothesis search resolution
   std::vector<double> downtilt_deg = {0.0, 10.0};
   IcpOptions coarse = [] {
     IcpOptions o;
@@ -41,22 +45,23 @@ struct GlobalStartOptions {
     o.kernel_scale = 0.005;
     return o;
   }();
-  double truncation_m = 0.02;      // τ
-  double ambiguity_ratio = 1.5;
+  double truncation_m = 0.02;  // τ
+  double ambiguity_margin = 0.03;
   std::vector<Vec3> viewpoints_scene;  // camera centres in the scene frame (optional)
 };
 
 struct Hypothesis {
   double yaw_rad = 0.0, downtilt_rad = 0.0;  // of the start
-  Iso3 T_model_scene = Iso3::Identity();      // after refinement
-  double residual = 0.0, unseen = 0.0;        // the two score parts
+  Iso3 T_model_scene = Iso3::Identity();     // after refinement
+  double residual = 0.0, unseen = 0.0;       // the two score parts
   double score() const { return residual + unseen; }
 };
 
 struct GlobalStartResult {
-  IcpResult fit;                      // the winner, refined with the fine options
-  std::vector<Hypothesis> hypotheses;  // all, best first
-  double front_back_ratio = 0.0;       // runner-up score / winner score (∞ without runner-up)
+  IcpResult fit;                       // the winner, refined with the fine options on the full clouds
+  Hypothesis winner, rival;            // full-resolution scores; rival.score() = ∞ without one
+  std::vector<Hypothesis> hypotheses;  // all, coarse scores, best first
+  double front_back_margin = 0.0;      // rival score − winner score (∞ without a rival)
   bool front_back_ambiguous = false;
 };
 

@@ -191,7 +191,8 @@ IcpResult align(const PreparedCloud& source, const PreparedCloud& target, const 
   return result;
 }
 
-double fitness_score(const PointCloud& source, const KdTree& target, const Iso3& T_target_source, double max_distance_m) {
+double fitness_score(const PointCloud& source, const KdTree& target, const Iso3& T_target_source,
+                     double max_distance_m) {
   const double max_d2 = max_distance_m * max_distance_m;
   double sum = 0.0;
   std::size_t n = 0;

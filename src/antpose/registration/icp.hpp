@@ -31,9 +31,9 @@ struct IcpOptions {
   int max_iterations = 50;
   double transformation_epsilon = 1e-8;  // see the file comment
   RobustKernel kernel = RobustKernel::kNone;
-  double kernel_scale = 0.01;            // m (whitened units for kGeneralized)
-  std::size_t normal_k = 10;             // neighbours for normals (point-to-plane, target)
-  std::size_t covariance_k = 20;         // neighbours for GICP covariances
+  double kernel_scale = 0.01;     // m (whitened units for kGeneralized)
+  std::size_t normal_k = 10;      // neighbours for normals (point-to-plane, target)
+  std::size_t covariance_k = 20;  // neighbours for GICP covariances
   double gicp_epsilon = 1e-3;
 };
 
@@ -52,9 +52,9 @@ struct IcpResult {
   Iso3 T_target_source = Iso3::Identity();
   bool converged = false;
   int iterations = 0;
-  std::size_t correspondences = 0;  // pairs within the distance at the result
+  std::size_t correspondences = 0;                           // pairs within the distance at the result
   double rmse_m = std::numeric_limits<double>::quiet_NaN();  // RMS point distance of those pairs
-  double fitness = 0.0;             // correspondences / source points
+  double fitness = 0.0;                                      // correspondences / source points
   /// Gauss–Newton information of the final step (6×6, rotation then translation, left
   /// perturbation in the target frame): unscaled JᵀWJ.
   Eigen::Matrix<double, 6, 6> information = Eigen::Matrix<double, 6, 6>::Zero();

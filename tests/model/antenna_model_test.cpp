@@ -1,0 +1,227 @@
+#include "antpose/model/antenna_model.hpp"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <numbers>
+#include <stdexcept>
+
+#include "antpose/core/error.hpp"
+#include "antpose/model/sampling.hpp"
+#include "support/test_support.hpp"
+
+namespace antpose::model {
+namespace {
+using ::testing::HasSubstr;
+
+template <class F>
+std::string input_error(F&& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no InputError thrown";
+  return "";
+}
+
+Iso3 known_pose() {
+  Iso3 T_mesh_antenna = Iso3::Identity();
+  T_mesh_antenna.linear() = exp_so3(Vec3(-0.4, 0.9, 2.6));
+  T_mesh_antenna.translation() = Vec3(-0.3, 2.0, 1.1);
+  return T_mesh_antenna;
+}
+
+double expected_volume(const PanelSpec& s) {
+  const double r = s.edge_radius_m;
+  double v = s.width_m * s.depth_m * s.height_m - (4 - std::numbers::pi) * r * r * s.height_m;
+  if (s.bracket) v += 2 * s.bracket_width_m * s.bracket_depth_m * s.bracket_height_m;
+  return v;
+}
+
+std::vector<PanelSpec> some_specs() {
+  std::vector<PanelSpec> specs(4);
+  specs[1].bracket = false;
+  specs[2].edge_radius_m = 0;
+  specs[3].width_m = 0.159, specs[3].depth_m = 0.08, specs[3].arc_segments = 12;
+  return specs;
+}
+
+TEST(Panel, IsClosedWithTheExpectedVolume) {
+  for (const PanelSpec& s : some_specs()) {
+    const AntennaModel m = parametric_panel(s);
+    EXPECT_TRUE(is_closed(m.mesh_antenna)) << m.name;
+    // Positive: wound outwards. The arcs are inscribed polygons, a little less than the formula.
+    EXPECT_NEAR(enclosed_volume(m.mesh_antenna) / expected_volume(s), 1.0, 0.005) << m.name;
+  }
+}
+
+TEST(Panel, SizeAndExtent) {
+  PanelSpec s;
+  const AntennaModel m = parametric_panel(s);
+  EXPECT_EQ(m.size_m, Vec3(0.30, 0.16, 1.31));
+  EXPECT_EQ(m.name, "parametric-1310x300x160");
+  EXPECT_TRUE(m.T_antenna_mesh.matrix().isIdentity());
+  const auto [lo, hi] = bounding_box(m.mesh_antenna);
+  EXPECT_LT((lo - Vec3(-0.15, -0.08 - s.bracket_depth_m, -0.655)).norm(), 1e-12);
+  EXPECT_LT((hi - Vec3(0.15, 0.08, 0.655)).norm(), 1e-12);
+}
+
+TEST(Panel, NormalsPointOutwards) {
+  const PanelSpec s;
+  const AntennaModel m = parametric_panel(s);
+  const PointCloud cloud = sample_surface(m.mesh_antenna, 0.01, 7);
+  std::size_t body = 0, bracket = 0;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const Vec3& p = cloud.points[i];
+    const Vec3& n = cloud.normals[i];
+    if (p.y() >= -s.depth_m / 2 - 1e-12) {  // the panel's convex body: away from its centre
+      ++body;
+      ASSERT_GT(p.dot(n), 0) << p.transpose() << " n " << n.transpose();
+    } else {  // a bracket: away from the bracket's centre
+      ++bracket;
+      const Vec3 centre(0, -s.depth_m / 2 - s.bracket_depth_m / 2, p.z() > 0 ? s.height_m / 4 : -s.height_m / 4);
+      ASSERT_GT((p - centre).dot(n), 0) << p.transpose() << " n " << n.transpose();
+    }
+  }
+  EXPECT_GT(body, 10000u);
+  EXPECT_GT(bracket, 300u);
+}
+
+TEST(Panel, InvalidSpecsAreRefused) {
+  const auto refusal = [](auto change) -> std::string {
+    PanelSpec s;
+    change(s);
+    try {
+      parametric_panel(s);
+    } catch (const std::invalid_argument& e) {
+      return e.what();
+    }
+    ADD_FAILURE() << "no std::invalid_argument thrown";
+    return "";
+  };
+  EXPECT_THAT(refusal([](PanelSpec& s) { s.width_m = 0; }), HasSubstr("panel size 0 x 0.16 x 1.31 m"));
+  EXPECT_THAT(refusal([](PanelSpec& s) { s.height_m = -1; }), HasSubstr("all must be > 0"));
+  EXPECT_THAT(
+      refusal([](PanelSpec& s) { s.edge_radius_m = 0.08; }),
+      HasSubstr("panel edge radius 0.08 m: must be ≥ 0 and below half the smaller of width and depth (0.08 m)"));
+  EXPECT_THAT(refusal([](PanelSpec& s) { s.edge_radius_m = -0.01; }), HasSubstr("panel edge radius -0.01 m"));
+  EXPECT_THAT(refusal([](PanelSpec& s) { s.arc_segments = 0; }), HasSubstr("arc_segments = 0"));
+  EXPECT_THAT(refusal([](PanelSpec& s) { s.bracket_width_m = 0.26; }),
+              HasSubstr("bracket width 0.26 m: must be below the flat part of the back plate"));
+  EXPECT_THAT(refusal([](PanelSpec& s) { s.bracket_height_m = 0.7; }),
+              HasSubstr("bracket height 0.7 m: must be below half the panel height"));
+  EXPECT_THAT(refusal([](PanelSpec& s) { s.bracket_depth_m = 0; }), HasSubstr("panel bracket size"));
+  PanelSpec no_bracket;
+  no_bracket.bracket = false, no_bracket.bracket_width_m = 5;  // ignored without brackets
+  EXPECT_NO_THROW(parametric_panel(no_bracket));
+}
+
+TEST(Panel, BuiltinsByName) {
+  for (const auto& name : builtin_panel_names()) {
+    const AntennaModel m = builtin_panel(name);
+    EXPECT_EQ(m.name, name);
+    EXPECT_TRUE(is_closed(m.mesh_antenna)) << name;
+  }
+  EXPECT_EQ(builtin_panel("thesis-1310x159x80").size_m, Vec3(0.159, 0.080, 1.31));
+  EXPECT_EQ(builtin_panel("panel-1310x300x160").size_m, Vec3(0.30, 0.16, 1.31));
+  EXPECT_EQ(builtin_panel("panel-2000x300x150").size_m, Vec3(0.30, 0.15, 2.0));
+  const std::string message = input_error([] { builtin_panel("yagi"); });
+  EXPECT_THAT(message, HasSubstr("unknown built-in antenna model 'yagi', known: panel-1310x300x160, "
+                                 "thesis-1310x159x80, panel-2000x300x150"));
+}
+
+TEST(AntennaModel, LoadsAMeshPlacedByItsBoxFile) {
+  test::TempDir dir;
+  const AntennaModel panel = parametric_panel(PanelSpec{});
+  write_ply(transformed(panel.mesh_antenna, known_pose()), dir / "scan.ply");
+  test::write_file(dir / "scan.box", format_box_file(box_corners(panel.size_m, known_pose())));
+  const AntennaModel m = load_antenna_model(dir / "scan.ply", dir / "scan.box");
+  EXPECT_EQ(m.name, "scan");
+  EXPECT_LT((m.size_m - panel.size_m).norm(), 1e-9);
+  EXPECT_LT((m.T_antenna_mesh.matrix() - known_pose().inverse().matrix()).cwiseAbs().maxCoeff(), 1e-9);
+  ASSERT_EQ(m.mesh_antenna.vertices.size(), panel.mesh_antenna.vertices.size());
+  for (std::size_t i = 0; i < m.mesh_antenna.vertices.size(); ++i)
+    ASSERT_LT((m.mesh_antenna.vertices[i] - panel.mesh_antenna.vertices[i]).norm(), 1e-9) << i;
+}
+
+TEST(AntennaModel, LoadsMillimetreFiles) {
+  test::TempDir dir;
+  const AntennaModel panel = parametric_panel(PanelSpec{});
+  Iso3 to_mm = known_pose();
+  to_mm.linear() *= 1000, to_mm.translation() *= 1000;  // a similarity, fine for writing files
+  write_ply(transformed(panel.mesh_antenna, Iso3(to_mm)), dir / "scan.obj.ply");
+  auto corners = box_corners(panel.size_m, known_pose());
+  for (auto& c : corners) c *= 1000;
+  test::write_file(dir / "scan.box", format_box_file(corners));
+  EXPECT_THAT(input_error([&] { load_antenna_model(dir / "scan.obj.ply", dir / "scan.box"); }),
+              HasSubstr("--model-units mm"));
+  const AntennaModel m = load_antenna_model(dir / "scan.obj.ply", dir / "scan.box", Units::kMillimetres);
+  EXPECT_LT((m.size_m - panel.size_m).norm(), 1e-9);
+  EXPECT_LT((m.mesh_antenna.vertices[5] - panel.mesh_antenna.vertices[5]).norm(), 1e-9);
+}
+
+TEST(AntennaModel, BoxInOtherUnitsOrPlaceIsRefused) {
+  test::TempDir dir;
+  const AntennaModel panel = parametric_panel(PanelSpec{});
+  write_ply(transformed(panel.mesh_antenna, known_pose()), dir / "scan.ply");
+  auto corners = box_corners(panel.size_m, known_pose());
+  for (auto& c : corners) c *= 1000;
+  test::write_file(dir / "mm.box", format_box_file(corners));
+  EXPECT_THAT(input_error([&] { load_antenna_model(dir / "scan.ply", dir / "mm.box"); }),
+              HasSubstr("mm.box: the box does not fit the mesh"));
+  corners = box_corners(panel.size_m);  // the antenna frame, not the file's coordinates
+  test::write_file(dir / "other.box", format_box_file(corners));
+  EXPECT_THAT(input_error([&] { load_antenna_model(dir / "scan.ply", dir / "other.box"); }),
+              HasSubstr("must be in the mesh's coordinates and units"));
+}
+
+TEST(AntennaModel, WithoutBoxFileTheFrameIsNotGuessed) {
+  test::TempDir dir;
+  PanelSpec s;
+  s.bracket = false;
+  const AntennaModel panel = parametric_panel(s);
+  write_ply(transformed(panel.mesh_antenna, known_pose()), dir / "scan.ply");
+  const std::string message = input_error([&] { load_antenna_model(dir / "scan.ply", std::nullopt); });
+  EXPECT_THAT(message, HasSubstr("scan.ply: a box file is needed to place this mesh in the antenna frame"));
+  EXPECT_THAT(message, HasSubstr("about 0.300 x 0.160 x 1.310 m, longest last"));
+  EXPECT_THAT(message, HasSubstr("or declare the mesh canonical"));
+}
+
+TEST(AntennaModel, CanonicalMeshIsOnlyCentred) {
+  test::TempDir dir;
+  const AntennaModel panel = parametric_panel(PanelSpec{});
+  const Iso3 shift(Eigen::Translation3d(1.0, -2.0, 3.0));
+  write_ply(transformed(panel.mesh_antenna, shift), dir / "canonical.ply");
+  const AntennaModel m = load_antenna_model(dir / "canonical.ply", std::nullopt, Units::kMetres, true);
+  const auto [lo, hi] = bounding_box(m.mesh_antenna);
+  EXPECT_LT(((lo + hi) / 2).norm(), 1e-12);
+  EXPECT_TRUE(m.T_antenna_mesh.linear().isIdentity());
+  // The bracket sticks out at the back, so the bounding box is deeper than the panel's box.
+  EXPECT_LT((m.size_m - Vec3(0.30, 0.16 + PanelSpec{}.bracket_depth_m, 1.31)).norm(), 1e-12);
+}
+
+TEST(AntennaModel, PointCloudIsNotAModel) {
+  test::TempDir dir;
+  PointCloud cloud;
+  cloud.points = {Vec3(0, 0, 0), Vec3(0.3, 0, 0), Vec3(0, 0, 1.3)};
+  write_ply(cloud, dir / "points.ply");
+  EXPECT_THAT(input_error([&] { load_antenna_model(dir / "points.ply", std::nullopt, Units::kMetres, true); }),
+              HasSubstr("points.ply: the mesh has no faces"));
+}
+
+TEST(AntennaModel, PrincipalAxesFindTheLongAxisUpToSign) {
+  PanelSpec s;
+  s.bracket = false;
+  const Mesh mesh = transformed(parametric_panel(s).mesh_antenna, known_pose());
+  const AntennaBox box = principal_axes_box(mesh);
+  EXPECT_LT((box.size_m - Vec3(0.30, 0.16, 1.31)).norm(), 1e-9);
+  const Mat3 R_pca_antenna = box.T_antenna_mesh.linear() * known_pose().linear();
+  // Each principal axis is an antenna axis, with either sign.
+  EXPECT_LT((R_pca_antenna.cwiseAbs() - Mat3::Identity()).cwiseAbs().maxCoeff(), 1e-9);
+  EXPECT_NEAR(R_pca_antenna.determinant(), 1.0, 1e-12);
+  EXPECT_LT((box.T_antenna_mesh * known_pose().translation()).norm(), 1e-9);  // centre of the box
+}
+
+}  // namespace
+}  // namespace antpose::model
