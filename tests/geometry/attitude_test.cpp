@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <random>
 
 namespace antpose {
@@ -130,6 +131,48 @@ TEST(ContactPlacement, AllPlacementsAreRotationsWithScreenFacingBack) {
     EXPECT_EQ(parse_contact_placement(to_string(p)), p);
   }
   EXPECT_THROW(parse_contact_placement("sideways"), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace antpose
+
+namespace antpose {
+namespace {
+
+// First-order propagation against a Monte Carlo of the same world-frame rotation error, and
+// against the closed forms of contact mode for an isotropic tilt error σ_t and heading error σ_h.
+TEST(AttitudeSigma, MatchesMonteCarloAndTheClosedForms) {
+  const double st = deg2rad(0.3), sh = deg2rad(1.5);
+  const Mat3 cov = Vec3(st * st, st * st, sh * sh).asDiagonal();
+  for (double downtilt_deg : {0.0, 8.0, 25.0}) {
+    const Mat3 R = rotation_from_attitude(deg2rad(40), deg2rad(downtilt_deg), deg2rad(2));
+    const auto s = attitude_sigma(R, cov);
+    ASSERT_TRUE(s.azimuth && s.roll);
+    std::mt19937_64 rng(5);
+    std::normal_distribution<double> g(0.0, 1.0);
+    double sa = 0, sd = 0, sr = 0;
+    const auto a0 = attitude_from_rotation(R);
+    const int n = 20000;
+    for (int i = 0; i < n; ++i) {
+      const Vec3 d(st * g(rng), st * g(rng), sh * g(rng));
+      const auto a = attitude_from_rotation(exp_so3(d) * R);
+      sa += std::pow(wrap_pi(*a.azimuth - *a0.azimuth), 2) / n;
+      sd += std::pow(a.downtilt - a0.downtilt, 2) / n;
+      sr += std::pow(wrap_pi(*a.roll - *a0.roll), 2) / n;
+    }
+    EXPECT_NEAR(*s.azimuth, std::sqrt(sa), 0.03 * std::sqrt(sa)) << downtilt_deg;
+    EXPECT_NEAR(s.downtilt, std::sqrt(sd), 0.03 * std::sqrt(sd)) << downtilt_deg;
+    EXPECT_NEAR(*s.roll, std::sqrt(sr), 0.03 * std::sqrt(sr)) << downtilt_deg;
+    const double dt = deg2rad(downtilt_deg);
+    EXPECT_NEAR(s.downtilt, st, 1e-6);
+    EXPECT_NEAR(*s.azimuth, std::hypot(sh, st * std::tan(dt)), 1e-6);
+    std::printf("downtilt %4.1f°: roll σ %.4f°, contact mode's σ_t/cos(downtilt) %.4f°\n", downtilt_deg,
+                rad2deg(*s.roll), rad2deg(st / std::cos(dt)));
+  }
+  // A vertical boresight: azimuth and roll undefined, so no σ for them either.
+  const auto v = attitude_sigma(rotation_from_attitude(0, deg2rad(90), 0), cov);
+  EXPECT_FALSE(v.azimuth);
+  EXPECT_FALSE(v.roll);
 }
 
 }  // namespace

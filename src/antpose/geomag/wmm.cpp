@@ -1,5 +1,6 @@
 #include "antpose/geomag/wmm.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <ctime>
@@ -321,12 +322,17 @@ std::string today_utc_iso() {
 
 Vec3 field_enu_uT(const GeomagneticElements& e) { return Vec3(e.y_nT, e.x_nT, -e.z_nT) / 1000.0; }
 
+double declination_sigma(double horizontal_intensity_nT) {
+  return deg2rad(std::hypot(0.26, 5417.0 / std::max(horizontal_intensity_nT, 1.0)));
+}
+
 SiteField site_field(const MagneticModel& model, const Site& site) {
   if (site.date.empty()) throw std::invalid_argument("the site has no date (YYYY-MM-DD) for the magnetic model");
   SiteField out;
   out.decimal_year = decimal_year_from_iso(site.date);
   out.elements = model.evaluate(site.lat_deg, site.lon_deg, site.alt_m / 1000.0, out.decimal_year);
   out.declination = deg2rad(out.elements.declination_deg);
+  out.declination_sigma = declination_sigma(out.elements.h_nT);
   out.inclination = deg2rad(out.elements.inclination_deg);
   out.field_enu_uT = field_enu_uT(out.elements);
   out.validity_warning = model.validity_warning(out.decimal_year);

@@ -135,6 +135,7 @@ Vec3 field_enu_uT(const GeomagneticElements& elements);
 /// What a measurement at a capture site needs from the model.
 struct SiteField {
   double declination = 0.0;  // rad, positive east: true azimuth = magnetic azimuth + declination
+  double declination_sigma = 0.0;  // rad, 1σ of the model's declination (declination_sigma())
   double inclination = 0.0;  // rad, positive down
   Vec3 field_enu_uT = Vec3::Zero();  // expected field, ENU true north, µT
   double decimal_year = 0.0;
@@ -142,6 +143,10 @@ struct SiteField {
   /// Set when the site's date is outside the model's validity; the caller shows it as a warning.
   std::optional<std::string> validity_warning;
 };
+
+/// 1σ of WMM's declination (rad) where the horizontal intensity is H: the WMM2025 technical
+/// report's error model (§3), σ_D = sqrt(0.26² + (5417 nT / H)²) degrees (≈ 0.37° at H = 21 µT).
+double declination_sigma(double horizontal_intensity_nT);
 
 /// Evaluates the model at a capture site (lat/lon deg, alt_m above the WGS84 ellipsoid, date
 /// "YYYY-MM-DD"). Throws std::invalid_argument for a bad date or position; callers turn it into

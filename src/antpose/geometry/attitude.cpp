@@ -1,5 +1,6 @@
 #include "antpose/geometry/attitude.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -22,6 +23,34 @@ AntennaAttitude attitude_from_rotation(const Mat3& R_world_antenna, double verti
   const Mat3 R_roll = rot_x(out.downtilt) * rot_z(azimuth) * R_world_antenna;
   out.azimuth = azimuth;
   out.roll = std::atan2(R_roll(0, 2), R_roll(0, 0));
+  return out;
+}
+
+AttitudeSigma attitude_sigma(const Mat3& R_world_antenna, const Mat3& covariance_world, double vertical_limit) {
+  const AntennaAttitude a0 = attitude_from_rotation(R_world_antenna, vertical_limit);
+  // Angles as a vector (azimuth, downtilt, roll); differences wrapped, so 359.9° vs 0.1° is 0.2°.
+  Eigen::Matrix3d J = Eigen::Matrix3d::Zero();
+  const double h = 1e-6;
+  bool defined = a0.azimuth.has_value();
+  for (int k = 0; k < 3; ++k) {
+    const Vec3 d = Vec3::Unit(k) * h;
+    const AntennaAttitude p = attitude_from_rotation(exp_so3(d) * R_world_antenna, vertical_limit);
+    const AntennaAttitude m = attitude_from_rotation(exp_so3(-d) * R_world_antenna, vertical_limit);
+    J(1, k) = (p.downtilt - m.downtilt) / (2 * h);
+    if (defined && p.azimuth && m.azimuth && p.roll && m.roll) {
+      J(0, k) = wrap_pi(*p.azimuth - *m.azimuth) / (2 * h);
+      J(2, k) = wrap_pi(*p.roll - *m.roll) / (2 * h);
+    } else {
+      defined = false;
+    }
+  }
+  const Mat3 S = J * covariance_world * J.transpose();
+  AttitudeSigma out;
+  out.downtilt = std::sqrt(std::max(0.0, S(1, 1)));
+  if (defined) {
+    out.azimuth = std::sqrt(std::max(0.0, S(0, 0)));
+    out.roll = std::sqrt(std::max(0.0, S(2, 2)));
+  }
   return out;
 }
 

@@ -36,6 +36,18 @@ Mat3 rotation_from_attitude(double azimuth, double downtilt, double roll);
 /// vertical, azimuth and roll are left empty: only their sum/difference is observable there.
 AntennaAttitude attitude_from_rotation(const Mat3& R_world_antenna, double vertical_limit = kDefaultVerticalLimit);
 
+/// 1σ of the attitude angles (rad) when R_world_antenna is uncertain by a world-frame rotation
+/// vector δ (R_true = exp(δ) R_est) of covariance `covariance_world` (rad²): first-order
+/// propagation through attitude_from_rotation, J Σ Jᵀ, with J by central differences. Azimuth
+/// and roll are empty where attitude_from_rotation leaves them empty.
+struct AttitudeSigma {
+  std::optional<double> azimuth;
+  double downtilt = 0.0;
+  std::optional<double> roll;
+};
+AttitudeSigma attitude_sigma(const Mat3& R_world_antenna, const Mat3& covariance_world,
+                             double vertical_limit = kDefaultVerticalLimit);
+
 /// Thesis gra(): angle between a world vector and gravity (straight down), in [0, π].
 double angle_from_down(const Vec3& v_world);
 /// Thesis nor(): clockwise angle from north of the horizontal projection of a world vector,

@@ -10,11 +10,6 @@
 namespace antpose::measure {
 namespace {
 
-// WMM2025 declination error model (technical report, §3): σ_D = sqrt(a² + (b/H)²) degrees,
-// a = 0.26°, b = 5417 nT·deg, H in nT (≈ 0.37° at H = 21 µT).
-constexpr double kWmmDeclinationSigmaDeg = 0.26;
-constexpr double kWmmDeclinationSigmaOverH_nT = 5417.0;
-
 bool is_iso_date(const std::string& s) {
   if (s.size() < 10) return false;
   try {
@@ -123,9 +118,7 @@ ContactResult measure_contact(const Capture& input, const ContactOptions& option
     r.declination = field.declination;
     r.expected_field_uT = field.elements.f_nT / 1000.0;
     r.expected_dip = field.inclination;
-    const double sigma_decl_deg =
-        std::hypot(kWmmDeclinationSigmaDeg, kWmmDeclinationSigmaOverH_nT / std::max(field.elements.h_nT, 1.0));
-    r.sigma.declination = deg2rad(sigma_decl_deg);
+    r.sigma.declination = field.declination_sigma;
     if (r.azimuth_magnetic) {
       r.azimuth_true = wrap_2pi(*r.azimuth_magnetic + field.declination);
       r.sigma.azimuth_true = std::hypot(r.sigma.azimuth, *r.sigma.declination);

@@ -1,0 +1,36 @@
+// The antenna's attitude from the non-contact chain: the board's attitude in the world
+// (board_world.hpp, ENU with magnetic north, as the orientation track) and the antenna's in the
+// board frame (registration of the model to the reconstructed points, board frame):
+//   R_world_antenna = R_world_board · R_board_antenna.
+// Covariance (world frame, rad², R_true = exp(δ) R_est): the board's plus the registration's
+// carried into the world, Σ = Σ_board + R_world_board Σ_reg R_world_boardᵀ (independent). The
+// angles' σ follow by first-order propagation (geometry/attitude.hpp attitude_sigma). True
+// azimuth = magnetic + declination, its σ adding WMM's declination σ in quadrature.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "antpose/geometry/attitude.hpp"
+#include "antpose/geomag/wmm.hpp"
+#include "antpose/measure/board_world.hpp"
+
+namespace antpose::measure {
+
+struct AntennaAttitudeResult {
+  Mat3 R_world_antenna = Mat3::Identity();  // world = ENU, magnetic north
+  Mat3 covariance = Mat3::Zero();           // rad², world frame
+  AntennaAttitude magnetic;                 // azimuth is magnetic
+  AttitudeSigma sigma;
+  std::optional<double> azimuth_true;        // rad, with a site
+  std::optional<double> azimuth_true_sigma;  // rad
+  std::vector<std::string> warnings;
+};
+
+/// `R_board_antenna` with covariance `cov_board` (rad², board frame, left perturbation);
+/// `site` gives the declination (none: no true azimuth).
+AntennaAttitudeResult antenna_attitude(const BoardWorldAttitude& board, const Mat3& R_board_antenna,
+                                       const Mat3& cov_board, const std::optional<geomag::SiteField>& site);
+
+}  // namespace antpose::measure

@@ -1,0 +1,139 @@
+#include "antpose/measure/board_world.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Eigenvalues>
+#include <fmt/format.h>
+
+namespace antpose::measure {
+namespace {
+
+void warn(Diagnostics& d, std::vector<std::string>& warnings, std::string message) {
+  warnings.push_back(message);
+  d.warn(std::move(message));
+}
+
+Mat3 chordal_mean(const std::vector<Mat3>& rotations) {
+  Mat3 sum = Mat3::Zero();
+  for (const auto& R : rotations) sum += R;
+  return nearest_rotation(sum);
+}
+
+/// Covariance of the track at t (world), or a generic phone's when the track has none.
+Mat3 track_covariance(const orientation::OrientationTrack& track, double t) {
+  const auto s = track.at(t);
+  if (s.covariance && s.covariance->allFinite() && s.covariance->trace() > 0.0) return *s.covariance;
+  const double tilt = deg2rad(0.5), heading = deg2rad(3.0);
+  return Vec3(tilt * tilt, tilt * tilt, heading * heading).asDiagonal();
+}
+
+}  // namespace
+
+Mat3 l1_rotation_median(const std::vector<Mat3>& rotations, int max_iterations) {
+  Mat3 R = chordal_mean(rotations);
+  for (int it = 0; it < max_iterations; ++it) {
+    Vec3 num = Vec3::Zero();
+    double den = 0.0;
+    for (const auto& Ri : rotations) {
+      const Vec3 v = log_so3(Ri * R.transpose());
+      const double w = 1.0 / std::max(v.norm(), 1e-9);  // Weiszfeld: inverse distance
+      num += w * v, den += w;
+    }
+    const Vec3 step = num / den;
+    R = exp_so3(step) * R;
+    if (step.norm() < 1e-12) break;
+  }
+  return R;
+}
+
+BoardWorldAttitude board_world_attitude(const std::vector<BoardPhoto>& photos, const orientation::OrientationTrack& track,
+                                        const CameraImu& ci, const BoardWorldOptions& o, Diagnostics& diagnostics) {
+  BoardWorldAttitude out;
+  std::vector<std::size_t> inside;
+  std::vector<Mat3> R_wb(photos.size()), R_wd(photos.size());
+  for (std::size_t i = 0; i < photos.size(); ++i) {
+    out.photos.push_back({photos[i].name, 0, 0, 0, true});
+    const double t = photos[i].t_shot + ci.time_offset_s;
+    if (!track.contains(t)) {
+      warn(diagnostics, out.warnings,
+           fmt::format("{} (t = {:.3f} s) has no phone orientation (outside the sensor data); left out", photos[i].name,
+                       photos[i].t_shot));
+      continue;
+    }
+    R_wd[i] = track.at(t).q_world_device.toRotationMatrix();
+    R_wb[i] = R_wd[i] * ci.R_device_camera * photos[i].R_camera_board;
+    inside.push_back(i);
+  }
+  if (inside.size() < o.min_photos)
+    throw MeasurementError(fmt::format("board attitude in the world: {} photo(s) with a board pose and a phone "
+                                       "orientation, at least {} needed",
+                                       inside.size(), o.min_photos));
+
+  // Median, outliers, median again without them.
+  std::vector<Mat3> all;
+  for (std::size_t i : inside) all.push_back(R_wb[i]);
+  const Mat3 first = l1_rotation_median(all, o.max_iterations);
+  std::vector<std::size_t> used;
+  std::vector<std::string> outliers;
+  for (std::size_t i : inside) {
+    if (rad2deg(rotation_distance(R_wb[i], first)) > o.outlier_deg) outliers.push_back(photos[i].name);
+    else used.push_back(i);
+  }
+  if (used.size() < o.min_photos)
+    throw MeasurementError(fmt::format("board attitude in the world: the photos disagree by more than {}° (outliers: "
+                                       "{}); check the board detection and the phone's orientation",
+                                       o.outlier_deg, fmt::join(outliers, ", ")));
+  if (!outliers.empty())
+    warn(diagnostics, out.warnings,
+         fmt::format("{} photo(s) imply a board attitude more than {}° from the others and are left out: {}",
+                     outliers.size(), o.outlier_deg, fmt::join(outliers, ", ")));
+  std::vector<Mat3> kept;
+  for (std::size_t i : used) kept.push_back(R_wb[i]);
+  out.R_world_board = l1_rotation_median(kept, o.max_iterations);
+  out.used = used.size();
+
+  // Residuals and the photos' scatter.
+  const double n = static_cast<double>(used.size());
+  Mat3 scatter = Mat3::Zero(), common = Mat3::Zero(), pnp = Mat3::Zero();
+  double heading_sq = 0.0;
+  for (std::size_t i : inside) {
+    const Vec3 v = log_so3(R_wb[i] * out.R_world_board.transpose());
+    auto& r = out.photos[i];
+    r.angle_deg = rad2deg(v.norm());
+    r.tilt_deg = rad2deg(v.head<2>().norm());
+    r.heading_deg = rad2deg(v.z());
+    r.outlier = std::find(used.begin(), used.end(), i) == used.end();
+    if (r.outlier) continue;
+    scatter += v * v.transpose() / n;
+    heading_sq += v.z() * v.z() / n;
+    const double t = photos[i].t_shot + ci.time_offset_s;
+    common += (track_covariance(track, t) + R_wd[i] * ci.covariance * R_wd[i].transpose()) / n;
+    const Mat3 R_wc = R_wd[i] * ci.R_device_camera;
+    pnp += R_wc * photos[i].cov_R_camera_board * R_wc.transpose() / (n * n);
+  }
+  out.heading_scatter_deg = rad2deg(std::sqrt(heading_sq));
+  const Mat3 scatter_of_mean = used.size() > 1 ? Mat3(scatter * n / (n - 1.0) / n) : Mat3::Zero();
+  out.covariance = common + (scatter_of_mean.trace() > pnp.trace() ? scatter_of_mean : pnp);
+
+  if (out.heading_scatter_deg > o.heading_scatter_warn_deg)
+    warn(diagnostics, out.warnings,
+         fmt::format("the photos disagree on the heading by {:.1f}° RMS (more than {}°): the magnetometer was probably "
+                     "disturbed near the mast; the azimuth is uncertain",
+                     out.heading_scatter_deg, o.heading_scatter_warn_deg));
+  // Where the cameras were, seen from the board: camera centre in the board frame, −R_cbᵀ t_cb.
+  for (std::size_t a = 0; a < used.size(); ++a)
+    for (std::size_t b = a + 1; b < used.size(); ++b) {
+      const Vec3 ca = -(photos[used[a]].R_camera_board.transpose() * photos[used[a]].t_camera_board);
+      const Vec3 cb = -(photos[used[b]].R_camera_board.transpose() * photos[used[b]].t_camera_board);
+      if (ca.norm() > 0 && cb.norm() > 0) out.view_spread_deg = std::max(out.view_spread_deg, rad2deg(angle_between(ca, cb)));
+    }
+  if (out.view_spread_deg < o.min_view_spread_deg)
+    warn(diagnostics, out.warnings,
+         fmt::format("all photos were taken from nearly one direction (largest angle between two views {:.1f}°, less "
+                     "than {}°): the reconstruction's depth and the registration are weak; walk around",
+                     out.view_spread_deg, o.min_view_spread_deg));
+  return out;
+}
+
+}  // namespace antpose::measure

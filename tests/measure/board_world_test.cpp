@@ -1,0 +1,147 @@
+#include "antpose/measure/board_world.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <random>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "antpose/measure/antenna_attitude.hpp"
+
+namespace antpose::measure {
+namespace {
+
+using ::testing::HasSubstr;
+
+struct Scene {
+  Mat3 R_world_board;
+  CameraImu ci;
+  std::vector<BoardPhoto> photos;
+  orientation::OrientationTrack track;
+};
+
+// `n` photos of a board from around it; the track is the truth turned by a common heading error
+// plus per-photo heading noise; PnP noise 0.05° per axis.
+Scene scene(int n, double common_heading_deg, double heading_noise_deg, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> g(0.0, 1.0);
+  Scene s;
+  s.R_world_board = exp_so3(Vec3(0.3, -0.2, 1.1));
+  s.ci.R_device_camera = Vec3(1, -1, -1).asDiagonal();
+  s.ci.covariance = Mat3::Identity() * std::pow(deg2rad(0.02), 2);
+  s.ci.time_offset_s = 0.03;
+  const double pnp = deg2rad(0.05);
+  const Mat3 cov = Vec3(std::pow(deg2rad(0.3), 2), std::pow(deg2rad(0.3), 2), std::pow(deg2rad(1.0), 2)).asDiagonal();
+  for (int i = 0; i < n; ++i) {
+    const double t = 1.0 + i;
+    // Camera 3 m from the board, around its normal (board z points into the board).
+    const double a = deg2rad(-40 + 80.0 * i / std::max(1, n - 1));
+    const Vec3 c_board(3 * std::sin(a), 0.5 * std::cos(3 * a), -3 * std::cos(a));
+    Mat3 R_board_camera;  // camera looking at the board's origin
+    const Vec3 z = (-c_board).normalized(), x = Vec3::UnitY().cross(z).normalized();
+    R_board_camera << x, z.cross(x), z;
+    const Mat3 R_camera_board = R_board_camera.transpose();
+    const Mat3 R_world_device = s.R_world_board * R_board_camera * s.ci.R_device_camera.transpose();
+    const double heading = deg2rad(common_heading_deg + heading_noise_deg * g(rng));
+    for (double dt : {-0.5, 0.0, 0.5})
+      s.track.push_back(t + s.ci.time_offset_s + dt, Quat(exp_so3(Vec3(0, 0, heading)) * R_world_device), cov);
+    BoardPhoto p;
+    p.name = "shot " + std::to_string(i);
+    p.t_shot = t;
+    p.R_camera_board = exp_so3(pnp * Vec3(g(rng), g(rng), g(rng))) * R_camera_board;
+    p.t_camera_board = -R_camera_board * c_board;
+    p.cov_R_camera_board = Mat3::Identity() * pnp * pnp;
+    s.photos.push_back(p);
+  }
+  return s;
+}
+
+TEST(BoardWorld, MedianCarriesTheCommonHeadingErrorAndItsSigma) {
+  const Scene s = scene(12, 1.0, 0.2, 1);
+  Diagnostics d;
+  const auto r = board_world_attitude(s.photos, s.track, s.ci, {}, d);
+  const Vec3 e = log_so3(r.R_world_board * s.R_world_board.transpose());
+  std::printf("error (%.3f, %.3f, %.3f)°, σ (%.3f, %.3f, %.3f)°, heading scatter %.2f°, view spread %.0f°\n",
+              rad2deg(e.x()), rad2deg(e.y()), rad2deg(e.z()), rad2deg(std::sqrt(r.covariance(0, 0))),
+              rad2deg(std::sqrt(r.covariance(1, 1))), rad2deg(std::sqrt(r.covariance(2, 2))), r.heading_scatter_deg,
+              r.view_spread_deg);
+  EXPECT_NEAR(rad2deg(e.z()), 1.0, 0.15);  // the common heading error does not average out ...
+  EXPECT_LT(e.head<2>().norm(), deg2rad(0.05));
+  EXPECT_NEAR(std::sqrt(r.covariance(2, 2)), deg2rad(1.0), deg2rad(0.05));  // ... and the σ says so
+  EXPECT_EQ(r.used, 12u);
+  EXPECT_TRUE(r.warnings.empty()) << r.warnings.front();
+}
+
+TEST(BoardWorld, OutliersAndDisturbanceAndOneSidedViewsAreReported) {
+  Scene s = scene(10, 0.0, 0.0, 2);
+  // A photo whose phone heading was off by 8° (steel): left out, named; the median unmoved.
+  const double t = s.photos[4].t_shot + s.ci.time_offset_s;
+  orientation::OrientationTrack track;
+  for (std::size_t k = 0; k < s.track.size(); ++k) {
+    Quat q = s.track.q_world_device[k];
+    if (std::abs(s.track.t[k] - t) < 0.6) q = Quat(exp_so3(Vec3(0, 0, deg2rad(8))) * q.toRotationMatrix());
+    track.push_back(s.track.t[k], q, s.track.covariance[k]);
+  }
+  Diagnostics d;
+  const auto r = board_world_attitude(s.photos, track, s.ci, {}, d);
+  EXPECT_TRUE(r.photos[4].outlier);
+  EXPECT_NEAR(r.photos[4].heading_deg, 8.0, 0.2);
+  EXPECT_TRUE(d.mentions("1 photo(s) imply a board attitude more than 2° from the others and are left out: shot 4"));
+  EXPECT_LT(rad2deg(rotation_distance(r.R_world_board, s.R_world_board)), 0.05);
+
+  // Heading scatter of 2.5° RMS between photos (threshold 1.5°): a disturbance warning.
+  const Scene noisy = scene(12, 0.0, 2.5, 3);
+  BoardWorldOptions loose;
+  loose.outlier_deg = 10;
+  Diagnostics dn;
+  const auto rn = board_world_attitude(noisy.photos, noisy.track, noisy.ci, loose, dn);
+  EXPECT_GT(rn.heading_scatter_deg, 1.5);
+  EXPECT_TRUE(dn.mentions("the photos disagree on the heading by"));
+
+  // All photos from one spot (camera centre −R_cbᵀ t_cb the same): warned.
+  Scene one = scene(5, 0.0, 0.0, 4);
+  const Vec3 centre = -(one.photos[0].R_camera_board.transpose() * one.photos[0].t_camera_board);
+  for (auto& p : one.photos) p.t_camera_board = -(p.R_camera_board * centre);
+  Diagnostics d1;
+  board_world_attitude(one.photos, one.track, one.ci, {}, d1);
+  EXPECT_TRUE(d1.mentions("all photos were taken from nearly one direction"));
+
+  // Photos without sensor data around them: named; too few left is an error.
+  Scene late = scene(3, 0.0, 0.0, 5);
+  late.photos[1].t_shot = 500.0;
+  late.photos[2].t_shot = 600.0;
+  Diagnostics dl;
+  try {
+    board_world_attitude(late.photos, late.track, late.ci, {}, dl);
+    ADD_FAILURE() << "expected a MeasurementError";
+  } catch (const MeasurementError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("1 photo(s) with a board pose and a phone orientation, at least 2 needed"));
+  }
+  EXPECT_TRUE(dl.mentions("shot 1 (t = 500.000 s) has no phone orientation (outside the sensor data); left out"));
+}
+
+TEST(AntennaAttitude, ComposesBoardAndRegistrationWithTrueNorth) {
+  const Scene s = scene(8, 0.0, 0.0, 6);
+  Diagnostics d;
+  const auto board = board_world_attitude(s.photos, s.track, s.ci, {}, d);
+  const Mat3 R_world_antenna = rotation_from_attitude(deg2rad(123.0), deg2rad(6.0), deg2rad(-1.0));
+  const Mat3 R_board_antenna = s.R_world_board.transpose() * R_world_antenna;
+  const Mat3 cov_reg = Mat3::Identity() * std::pow(deg2rad(0.05), 2);
+  geomag::SiteField site;
+  site.declination = deg2rad(-6.0);
+  site.declination_sigma = deg2rad(0.35);
+  const auto r = antenna_attitude(board, R_board_antenna, cov_reg, site);
+  ASSERT_TRUE(r.magnetic.azimuth && r.azimuth_true && r.sigma.azimuth);
+  EXPECT_NEAR(rad2deg(*r.magnetic.azimuth), 123.0, 0.1);
+  EXPECT_NEAR(rad2deg(r.magnetic.downtilt), 6.0, 0.05);
+  EXPECT_NEAR(rad2deg(*r.magnetic.roll), -1.0, 0.05);
+  EXPECT_NEAR(rad2deg(*r.azimuth_true), 117.0, 0.1);
+  EXPECT_NEAR(*r.azimuth_true_sigma, std::hypot(*r.sigma.azimuth, deg2rad(0.35)), 1e-12);
+  // The board's heading σ (1°) dominates the azimuth; downtilt is set by tilt σ (0.3°) and registration.
+  EXPECT_NEAR(rad2deg(*r.sigma.azimuth), 1.0, 0.1);
+  EXPECT_LT(rad2deg(r.sigma.downtilt), 0.4);
+}
+
+}  // namespace
+}  // namespace antpose::measure
