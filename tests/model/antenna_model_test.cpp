@@ -14,17 +14,6 @@ namespace antpose::model {
 namespace {
 using ::testing::HasSubstr;
 
-template <class F>
-std::string input_error(F&& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "no InputError thrown";
-  return "";
-}
-
 Iso3 known_pose() {
   Iso3 T_mesh_antenna = Iso3::Identity();
   T_mesh_antenna.linear() = exp_so3(Vec3(-0.4, 0.9, 2.6));
@@ -126,7 +115,7 @@ TEST(Panel, BuiltinsByName) {
   EXPECT_EQ(builtin_panel("thesis-1310x159x80").size_m, Vec3(0.159, 0.080, 1.31));
   EXPECT_EQ(builtin_panel("panel-1310x300x160").size_m, Vec3(0.30, 0.16, 1.31));
   EXPECT_EQ(builtin_panel("panel-2000x300x150").size_m, Vec3(0.30, 0.15, 2.0));
-  const std::string message = input_error([] { builtin_panel("yagi"); });
+  const std::string message = test::input_error([] { builtin_panel("yagi"); });
   EXPECT_THAT(message, HasSubstr("unknown built-in antenna model 'yagi', known: panel-1310x300x160, "
                                  "thesis-1310x159x80, panel-2000x300x150"));
 }
@@ -154,7 +143,7 @@ TEST(AntennaModel, LoadsMillimetreFiles) {
   auto corners = box_corners(panel.size_m, known_pose());
   for (auto& c : corners) c *= 1000;
   test::write_file(dir / "scan.box", format_box_file(corners));
-  EXPECT_THAT(input_error([&] { load_antenna_model(dir / "scan.obj.ply", dir / "scan.box"); }),
+  EXPECT_THAT(test::input_error([&] { load_antenna_model(dir / "scan.obj.ply", dir / "scan.box"); }),
               HasSubstr("--model-units mm"));
   const AntennaModel m = load_antenna_model(dir / "scan.obj.ply", dir / "scan.box", Units::kMillimetres);
   EXPECT_LT((m.size_m - panel.size_m).norm(), 1e-9);
@@ -168,11 +157,11 @@ TEST(AntennaModel, BoxInOtherUnitsOrPlaceIsRefused) {
   auto corners = box_corners(panel.size_m, known_pose());
   for (auto& c : corners) c *= 1000;
   test::write_file(dir / "mm.box", format_box_file(corners));
-  EXPECT_THAT(input_error([&] { load_antenna_model(dir / "scan.ply", dir / "mm.box"); }),
+  EXPECT_THAT(test::input_error([&] { load_antenna_model(dir / "scan.ply", dir / "mm.box"); }),
               HasSubstr("mm.box: the box does not fit the mesh"));
   corners = box_corners(panel.size_m);  // the antenna frame, not the file's coordinates
   test::write_file(dir / "other.box", format_box_file(corners));
-  EXPECT_THAT(input_error([&] { load_antenna_model(dir / "scan.ply", dir / "other.box"); }),
+  EXPECT_THAT(test::input_error([&] { load_antenna_model(dir / "scan.ply", dir / "other.box"); }),
               HasSubstr("must be in the mesh's coordinates and units"));
 }
 
@@ -182,7 +171,7 @@ TEST(AntennaModel, WithoutBoxFileTheFrameIsNotGuessed) {
   s.bracket = false;
   const AntennaModel panel = parametric_panel(s);
   write_ply(transformed(panel.mesh_antenna, known_pose()), dir / "scan.ply");
-  const std::string message = input_error([&] { load_antenna_model(dir / "scan.ply", std::nullopt); });
+  const std::string message = test::input_error([&] { load_antenna_model(dir / "scan.ply", std::nullopt); });
   EXPECT_THAT(message, HasSubstr("scan.ply: a box file is needed to place this mesh in the antenna frame"));
   EXPECT_THAT(message, HasSubstr("about 0.300 x 0.160 x 1.310 m, longest last"));
   EXPECT_THAT(message, HasSubstr("or declare the mesh canonical"));
@@ -206,7 +195,7 @@ TEST(AntennaModel, PointCloudIsNotAModel) {
   PointCloud cloud;
   cloud.points = {Vec3(0, 0, 0), Vec3(0.3, 0, 0), Vec3(0, 0, 1.3)};
   write_ply(cloud, dir / "points.ply");
-  EXPECT_THAT(input_error([&] { load_antenna_model(dir / "points.ply", std::nullopt, Units::kMetres, true); }),
+  EXPECT_THAT(test::input_error([&] { load_antenna_model(dir / "points.ply", std::nullopt, Units::kMetres, true); }),
               HasSubstr("points.ply: the mesh has no faces"));
 }
 

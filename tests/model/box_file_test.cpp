@@ -12,17 +12,6 @@ namespace antpose::model {
 namespace {
 using ::testing::HasSubstr;
 
-template <class F>
-std::string input_error(F&& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "no InputError thrown";
-  return "";
-}
-
 Iso3 known_pose() {
   Iso3 T_mesh_antenna = Iso3::Identity();
   T_mesh_antenna.linear() = exp_so3(Vec3(0.3, -1.2, 2.0));
@@ -77,42 +66,42 @@ TEST(BoxFile, ToleratesHandPickedCorners) {
 
 TEST(BoxFile, MissingDuplicateAndUnknownLabels) {
   const auto c = box_corners(kSize);
-  EXPECT_THAT(input_error([&] {
+  EXPECT_THAT(test::input_error([&] {
                 parse_box_file(box_text(c, {0, 1, 2, 3, 4, 5, 7, 7}), "box.txt");
               }),
               HasSubstr("box.txt:8: corner H given twice (first on line 7)"));
   std::string text = box_text(c);
   text = text.substr(0, text.find("G "));  // drop G and H
-  EXPECT_THAT(input_error([&] { parse_box_file(text, "box.txt"); }),
+  EXPECT_THAT(test::input_error([&] { parse_box_file(text, "box.txt"); }),
               HasSubstr("box.txt: missing corners G, H: a box file needs each of A B C D E F G H exactly once"));
-  EXPECT_THAT(input_error([&] { parse_box_file("I 0 0 0\n", "box.txt"); }),
+  EXPECT_THAT(test::input_error([&] { parse_box_file("I 0 0 0\n", "box.txt"); }),
               HasSubstr("box.txt:1: unknown corner label 'I'"));
 }
 
 TEST(BoxFile, BadLinesNameFileAndLine) {
-  EXPECT_THAT(input_error([] { parse_box_file("# c\nA 0 0 0\nB 1 x1 0\n", "box.txt"); }),
+  EXPECT_THAT(test::input_error([] { parse_box_file("# c\nA 0 0 0\nB 1 x1 0\n", "box.txt"); }),
               HasSubstr("box.txt:3: bad number 'x1' for corner B"));
-  EXPECT_THAT(input_error([] { parse_box_file("A 0 0\n", "box.txt"); }),
+  EXPECT_THAT(test::input_error([] { parse_box_file("A 0 0\n", "box.txt"); }),
               HasSubstr("box.txt:1: 3 fields, expected 'LABEL x y z'"));
-  EXPECT_THAT(input_error([] { parse_box_file("A 0 0 0 4\n", "box.txt"); }), HasSubstr("box.txt:1: 5 fields"));
+  EXPECT_THAT(test::input_error([] { parse_box_file("A 0 0 0 4\n", "box.txt"); }), HasSubstr("box.txt:1: 5 fields"));
 }
 
 TEST(BoxFile, CornersThatAreNotABox) {
   auto c = box_corners(kSize, known_pose());
   auto moved = c;
   moved[2] += known_pose().linear() * Vec3(0.05, 0, 0);  // C 5 cm off to the right
-  const std::string message = input_error([&] { parse_box_file(box_text(moved), "box.txt"); });
+  const std::string message = test::input_error([&] { parse_box_file(box_text(moved), "box.txt"); });
   EXPECT_THAT(message, HasSubstr("box.txt: not a box: edges AD and BC should be parallel"));
   EXPECT_THAT(message, HasSubstr("check corners B and C (lines 2 and 3)"));
 
   auto same = c;
   same[1] = same[0];
-  EXPECT_THAT(input_error([&] { parse_box_file(box_text(same), "box.txt"); }),
+  EXPECT_THAT(test::input_error([&] { parse_box_file(box_text(same), "box.txt"); }),
               HasSubstr("edge AB is 0 m long: corners A and B (lines 1 and 2) (nearly) coincide"));
 
   auto swapped = c;
   std::swap(swapped[2], swapped[3]);  // C and D
-  EXPECT_THAT(input_error([&] { parse_box_file(box_text(swapped), "box.txt"); }),
+  EXPECT_THAT(test::input_error([&] { parse_box_file(box_text(swapped), "box.txt"); }),
               HasSubstr("edge DC runs opposite to AB (both should point along x_a (width)): either A and B (lines 1 "
                         "and 2) or D and C (lines 4 and 3) seem swapped"));
 }
@@ -123,18 +112,18 @@ TEST(BoxFile, UnequalOppositeEdgesStateTheLengths) {
   auto c = box_corners(Vec3(0.1, 1.0, 1.0));
   c[2].x() += 0.003;
   c[6].x() += 0.003;
-  EXPECT_THAT(input_error([&] { parse_box_file(box_text(c), "box.txt"); }),
+  EXPECT_THAT(test::input_error([&] { parse_box_file(box_text(c), "box.txt"); }),
               HasSubstr("not a box: the four edges along x_a (width) should be equal but are AB = 0.1 m, DC = 0.103 m, "
                         "EF = 0.1 m, HG = 0.103 m (2.9 % apart, tolerance 2 %)"));
   c[6].x() -= 0.003;  // only C off now: DC is the one edge that disagrees
-  EXPECT_THAT(input_error([&] { parse_box_file(box_text(c), "box.txt"); }),
+  EXPECT_THAT(test::input_error([&] { parse_box_file(box_text(c), "box.txt"); }),
               HasSubstr("(2.9 % apart, tolerance 2 %); DC (lines 4 and 3) is the odd one out"));
 }
 
 TEST(BoxFile, SkewedBoxIsNotRectangular) {
   auto c = box_corners(kSize);
   for (auto& p : c) p.x() += std::tan(deg2rad(5)) * p.y();  // shear: AD leans by 5°
-  EXPECT_THAT(input_error([&] { parse_box_file(box_text(c), "box.txt"); }),
+  EXPECT_THAT(test::input_error([&] { parse_box_file(box_text(c), "box.txt"); }),
               HasSubstr("not a box: edges AB and AD should be perpendicular but meet at 85.00° (tolerance 2°); check "
                         "corners A, B and D (lines 1, 2, 4)"));
 }
@@ -143,12 +132,12 @@ TEST(BoxFile, MirroredBoxSaysWhichLabelsSeemSwapped) {
   const auto c = box_corners(kSize, known_pose());
   // Left and right exchanged: A↔B, C↔D, E↔F, G↔H.
   const std::array<Vec3, 8> lr = {c[1], c[0], c[3], c[2], c[5], c[4], c[7], c[6]};
-  const std::string message = input_error([&] { parse_box_file(box_text(lr), "box.txt"); });
+  const std::string message = test::input_error([&] { parse_box_file(box_text(lr), "box.txt"); });
   EXPECT_THAT(message, HasSubstr("box.txt: the corners form a mirrored box"));
   EXPECT_THAT(message, HasSubstr("left and right are swapped (A↔B, D↔C, E↔F, H↔G)"));
   // Width and depth exchanged: B↔D, F↔H.
   const std::array<Vec3, 8> wd = {c[0], c[3], c[2], c[1], c[4], c[7], c[6], c[5]};
-  EXPECT_THAT(input_error([&] { parse_box_file(box_text(wd), "box.txt"); }),
+  EXPECT_THAT(test::input_error([&] { parse_box_file(box_text(wd), "box.txt"); }),
               HasSubstr("B and D (and F and H) seem swapped"));
 }
 

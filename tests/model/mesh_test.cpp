@@ -18,18 +18,6 @@ namespace {
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 
-// The message of the InputError that `f` throws (fails the test when it throws none).
-template <class F>
-std::string input_error(F&& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "no InputError thrown";
-  return "";
-}
-
 // A cube of side `s` centred at the origin, outward winding, as an OBJ with quads.
 std::string cube_obj(double s) {
   const double h = s / 2;
@@ -71,20 +59,20 @@ TEST(MeshObj, NegativeIndicesCountBackFromTheLatestVertex) {
 }
 
 TEST(MeshObj, MalformedInputNamesFileAndLine) {
-  EXPECT_THAT(input_error([] { parse_obj("v 0 0 0\nv 1 x 0\n", "bad.obj"); }), HasSubstr("bad.obj:2: bad number 'x'"));
-  EXPECT_THAT(input_error([] { parse_obj("v 0 0\n", "bad.obj"); }), HasSubstr("bad.obj:1: vertex has 2 coordinates"));
-  EXPECT_THAT(input_error([] { parse_obj("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n", "bad.obj"); }),
+  EXPECT_THAT(test::input_error([] { parse_obj("v 0 0 0\nv 1 x 0\n", "bad.obj"); }), HasSubstr("bad.obj:2: bad number 'x'"));
+  EXPECT_THAT(test::input_error([] { parse_obj("v 0 0\n", "bad.obj"); }), HasSubstr("bad.obj:1: vertex has 2 coordinates"));
+  EXPECT_THAT(test::input_error([] { parse_obj("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n", "bad.obj"); }),
               HasSubstr("bad.obj:4: vertex index 4 out of range: 3 vertices"));
-  EXPECT_THAT(input_error([] { parse_obj("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 -4\n", "bad.obj"); }),
+  EXPECT_THAT(test::input_error([] { parse_obj("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 -4\n", "bad.obj"); }),
               HasSubstr("bad.obj:4: vertex index -4 out of range"));
-  EXPECT_THAT(input_error([] { parse_obj("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n", "bad.obj"); }),
+  EXPECT_THAT(test::input_error([] { parse_obj("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n", "bad.obj"); }),
               HasSubstr("bad.obj:4: vertex index 0"));
-  EXPECT_THAT(input_error([] { parse_obj("v 0 0 0\nv 1 0 0\nf 1 2\n", "bad.obj"); }),
+  EXPECT_THAT(test::input_error([] { parse_obj("v 0 0 0\nv 1 0 0\nf 1 2\n", "bad.obj"); }),
               HasSubstr("bad.obj:3: face with 2 vertices"));
-  EXPECT_THAT(input_error([] { parse_obj("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 a 3\n", "bad.obj"); }),
+  EXPECT_THAT(test::input_error([] { parse_obj("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 a 3\n", "bad.obj"); }),
               HasSubstr("bad.obj:4: bad vertex index 'a'"));
-  EXPECT_THAT(input_error([] { parse_obj("# nothing\nvt 0 0\n", "empty.obj"); }), HasSubstr("empty.obj: no vertices"));
-  EXPECT_THAT(input_error([] { parse_obj("v 0 0 nan\n", "bad.obj"); }), HasSubstr("bad.obj:1: bad number 'nan'"));
+  EXPECT_THAT(test::input_error([] { parse_obj("# nothing\nvt 0 0\n", "empty.obj"); }), HasSubstr("empty.obj: no vertices"));
+  EXPECT_THAT(test::input_error([] { parse_obj("v 0 0 nan\n", "bad.obj"); }), HasSubstr("bad.obj:1: bad number 'nan'"));
 }
 
 TEST(MeshRead, ObjCubeHasOutwardVolumeAndIsClosed) {
@@ -195,7 +183,7 @@ TEST(MeshPly, TruncatedBinaryIsAnError) {
   std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   bytes.resize(bytes.size() - 10);  // inside the second face
   test::write_file(dir / "cut.ply", bytes);
-  const std::string message = input_error([&] { read_mesh(dir / "cut.ply"); });
+  const std::string message = test::input_error([&] { read_mesh(dir / "cut.ply"); });
   EXPECT_THAT(message, HasSubstr("cut.ply: truncated binary data"));
   EXPECT_THAT(message, HasSubstr("'face' 2 of 2"));
 }
@@ -212,35 +200,35 @@ TEST(MeshPly, MalformedInputNamesFileAndLine) {
   const std::string head =
       "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
       "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
-  EXPECT_THAT(input_error([&] { parse_ply(head + "0 0 0\n1 0 0\n0 1 zz\n3 0 1 2\n", "m.ply"); }),
+  EXPECT_THAT(test::input_error([&] { parse_ply(head + "0 0 0\n1 0 0\n0 1 zz\n3 0 1 2\n", "m.ply"); }),
               HasSubstr("m.ply:12: bad number 'zz'"));
-  EXPECT_THAT(input_error([&] { parse_ply(head + "0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n", "m.ply"); }),
+  EXPECT_THAT(test::input_error([&] { parse_ply(head + "0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n", "m.ply"); }),
               HasSubstr("m.ply:13: vertex index 3 out of range: the file has 3 vertices"));
-  EXPECT_THAT(input_error([&] { parse_ply(head + "0 0 0\n1 0 0\n0 1 0\n3 0 1 -1\n", "m.ply"); }),
+  EXPECT_THAT(test::input_error([&] { parse_ply(head + "0 0 0\n1 0 0\n0 1 0\n3 0 1 -1\n", "m.ply"); }),
               HasSubstr("m.ply:13: vertex index -1 out of range"));
-  EXPECT_THAT(input_error([&] { parse_ply(head + "0 0 0\n1 0 0\n0 1 0\n2 0 1\n", "m.ply"); }),
+  EXPECT_THAT(test::input_error([&] { parse_ply(head + "0 0 0\n1 0 0\n0 1 0\n2 0 1\n", "m.ply"); }),
               HasSubstr("m.ply:13: face with 2 vertices"));
-  EXPECT_THAT(input_error([&] { parse_ply(head + "0 0 0\n1 0 0\n0 1\n3 0 1 2\n", "m.ply"); }),
+  EXPECT_THAT(test::input_error([&] { parse_ply(head + "0 0 0\n1 0 0\n0 1\n3 0 1 2\n", "m.ply"); }),
               HasSubstr("m.ply:12: too few values"));
-  EXPECT_THAT(input_error([&] { parse_ply(head + "0 0 0\n1 0 0 9\n0 1 0\n3 0 1 2\n", "m.ply"); }),
+  EXPECT_THAT(test::input_error([&] { parse_ply(head + "0 0 0\n1 0 0 9\n0 1 0\n3 0 1 2\n", "m.ply"); }),
               HasSubstr("m.ply:11: 4 values for a 'vertex', the header declares 3"));
-  EXPECT_THAT(input_error([&] { parse_ply(head + "0 0 0\n1 0 0\n", "m.ply"); }),
+  EXPECT_THAT(test::input_error([&] { parse_ply(head + "0 0 0\n1 0 0\n", "m.ply"); }),
               HasSubstr("file ends after 2 of 3 'vertex' lines"));
-  EXPECT_THAT(input_error([] {
+  EXPECT_THAT(test::input_error([] {
                 parse_ply(
                     "ply\nformat ascii 1.0\nelement vertex 0\nproperty float x\nproperty float "
                     "y\nproperty float z\nend_header\n",
                     "m.ply");
               }),
               HasSubstr("m.ply: no vertices"));
-  EXPECT_THAT(input_error([] { parse_ply("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n", "m.ply"); }),
+  EXPECT_THAT(test::input_error([] { parse_ply("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n", "m.ply"); }),
               HasSubstr("no end_header"));
-  EXPECT_THAT(input_error([] { parse_ply("solid x\n", "m.ply"); }), HasSubstr("m.ply:1: not a PLY file"));
-  EXPECT_THAT(input_error([] { parse_ply("ply\nformat binary_middle_endian 1.0\nend_header\n", "m.ply"); }),
+  EXPECT_THAT(test::input_error([] { parse_ply("solid x\n", "m.ply"); }), HasSubstr("m.ply:1: not a PLY file"));
+  EXPECT_THAT(test::input_error([] { parse_ply("ply\nformat binary_middle_endian 1.0\nend_header\n", "m.ply"); }),
               HasSubstr("m.ply:2: unknown PLY format 'binary_middle_endian'"));
-  EXPECT_THAT(input_error([] { parse_ply("ply\nformat ascii 1.0\nelement vertex 1\nproperty float128 x\n", "m.ply"); }),
+  EXPECT_THAT(test::input_error([] { parse_ply("ply\nformat ascii 1.0\nelement vertex 1\nproperty float128 x\n", "m.ply"); }),
               HasSubstr("m.ply:4: unknown property type 'float128'"));
-  EXPECT_THAT(input_error([] {
+  EXPECT_THAT(test::input_error([] {
                 parse_ply(
                     "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float "
                     "y\nend_header\n0 0\n",
@@ -252,15 +240,15 @@ TEST(MeshPly, MalformedInputNamesFileAndLine) {
 TEST(MeshRead, UnknownFormatAndMissingFile) {
   test::TempDir dir;
   test::write_file(dir / "model.stl", "solid x\n");
-  EXPECT_THAT(input_error([&] { read_mesh(dir / "model.stl"); }),
+  EXPECT_THAT(test::input_error([&] { read_mesh(dir / "model.stl"); }),
               HasSubstr("model.stl: unknown mesh format '.stl', expected a .obj or .ply file"));
-  EXPECT_THAT(input_error([&] { read_mesh(dir / "absent.obj"); }), HasSubstr("absent.obj: file not found"));
+  EXPECT_THAT(test::input_error([&] { read_mesh(dir / "absent.obj"); }), HasSubstr("absent.obj: file not found"));
 }
 
 TEST(MeshUnits, MillimetresReadAsMetresAreRefusedWithTheFix) {
   test::TempDir dir;
   test::write_file(dir / "panel.obj", cube_obj(1310));
-  const std::string message = input_error([&] { read_mesh(dir / "panel.obj"); });
+  const std::string message = test::input_error([&] { read_mesh(dir / "panel.obj"); });
   EXPECT_THAT(message, HasSubstr("panel.obj: the model is 1310 m long"));
   EXPECT_THAT(message, HasSubstr("almost surely in millimetres"));
   EXPECT_THAT(message, HasSubstr("--model-units mm"));
@@ -271,11 +259,11 @@ TEST(MeshUnits, MillimetresReadAsMetresAreRefusedWithTheFix) {
 TEST(MeshUnits, TooSmallModelsAreRefused) {
   test::TempDir dir;
   test::write_file(dir / "metres.obj", cube_obj(1.31));
-  EXPECT_THAT(input_error([&] { read_mesh(dir / "metres.obj", Units::kMillimetres); }),
+  EXPECT_THAT(test::input_error([&] { read_mesh(dir / "metres.obj", Units::kMillimetres); }),
               HasSubstr("only 0.00131 m long (largest side of its bounding box) when read as millimetres, less than "
                         "0.05 m: the file is probably in metres; drop --model-units mm"));
   test::write_file(dir / "tiny.obj", cube_obj(0.01));
-  EXPECT_THAT(input_error([&] { read_mesh(dir / "tiny.obj"); }),
+  EXPECT_THAT(test::input_error([&] { read_mesh(dir / "tiny.obj"); }),
               HasSubstr("tiny.obj: the model is only 0.01 m long (largest side of its bounding box) when read as "
                         "metres, less than 0.05 m"));
 }

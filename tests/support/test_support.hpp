@@ -5,6 +5,10 @@
 #include <string>
 #include <string_view>
 
+#include <gtest/gtest.h>
+
+#include "antpose/core/error.hpp"
+
 namespace antpose::test {
 
 /// Path of `relative` inside ANTPOSE_SHARED_DIR (a CMake cache variable, default ../shared).
@@ -40,5 +44,17 @@ struct CliResult {
 
 /// Runs the antpose executable with the given argument string (shell syntax).
 CliResult run_cli(const std::string& args);
+
+/// The message of the InputError that `f` throws; fails the calling test when it throws none.
+template <class F>
+std::string input_error(F&& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no InputError thrown";
+  return "";
+}
 
 }  // namespace antpose::test
