@@ -374,12 +374,6 @@ Mat3 hand_eye_rotation(const std::vector<Mat3>& R_world_device, const std::vecto
   return svd.matrixV() * D * svd.matrixU().transpose();
 }
 
-Mat3 chordal_mean(const std::vector<Mat3>& rotations) {
-  Mat3 sum = Mat3::Zero();
-  for (const auto& R : rotations) sum += R;
-  return nearest_rotation(sum);
-}
-
 Vec2 principal_point_rotation_sigma(const camera::CameraIntrinsics& intrinsics, const Vec2& principal_point_sigma_px) {
   return {principal_point_sigma_px.y() / intrinsics.fy, principal_point_sigma_px.x() / intrinsics.fx};
 }

@@ -139,8 +139,6 @@ std::string format_angle_error_table(const AngleErrorTable& table);
 Mat3 hand_eye_rotation(const std::vector<Mat3>& R_world_device, const std::vector<Mat3>& R_camera_board,
                        const std::vector<std::size_t>& group);
 
-/// Chordal L2 mean of rotations: the rotation nearest (Frobenius) to their sum.
-Mat3 chordal_mean(const std::vector<Mat3>& rotations);
 
 struct ReferenceFreeOptions {
   std::optional<Mat3> R_start;              // skip the closed-form start (still refined)

@@ -57,4 +57,11 @@ Vec3 log_so3(const Mat3& R) {
 
 double angle_between(const Vec3& a, const Vec3& b) { return std::atan2(a.cross(b).norm(), a.dot(b)); }
 
+Mat3 chordal_mean(const std::vector<Mat3>& rotations) {
+  if (rotations.empty()) return Mat3::Identity();
+  Mat3 sum = Mat3::Zero();
+  for (const auto& R : rotations) sum += R;
+  return nearest_rotation(sum);
+}
+
 }  // namespace antpose

@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <numbers>
+#include <vector>
 
 namespace antpose {
 
@@ -35,6 +36,10 @@ double rotation_distance(const Mat3& R_a, const Mat3& R_b);
 
 /// Projects a nearly orthogonal matrix onto SO(3) (closest rotation in Frobenius norm, via SVD).
 Mat3 nearest_rotation(const Mat3& M);
+
+/// Chordal L2 mean of rotations: the rotation nearest (Frobenius) to their sum (Hartley, Trumpf,
+/// Dai & Li, "Rotation averaging", IJCV 103, 2013). Identity for an empty list.
+Mat3 chordal_mean(const std::vector<Mat3>& rotations);
 
 /// Skew-symmetric matrix [v]x with [v]x w = v × w.
 Mat3 skew(const Vec3& v);

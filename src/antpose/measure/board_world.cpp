@@ -14,12 +14,6 @@ void warn(Diagnostics& d, std::vector<std::string>& warnings, std::string messag
   d.warn(std::move(message));
 }
 
-Mat3 chordal_mean(const std::vector<Mat3>& rotations) {
-  Mat3 sum = Mat3::Zero();
-  for (const auto& R : rotations) sum += R;
-  return nearest_rotation(sum);
-}
-
 /// Covariance of the track at t (world), or a generic phone's when the track has none.
 Mat3 track_covariance(const orientation::OrientationTrack& track, double t) {
   const auto s = track.at(t);
