@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <filesystem>
 #include <map>
-#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -97,14 +96,6 @@ std::vector<orientation::BenchmarkTrial> load_trials(const OrientationBenchArgs&
   for (const auto& folder : capture_folders(args.dirs))
     trials.push_back(orientation::load_benchmark_trial(folder, models, diagnostics, scoring));
   return trials;
-}
-
-std::vector<std::string> split_list(const std::string& text) {
-  std::vector<std::string> out;
-  std::stringstream ss(text);
-  for (std::string item; std::getline(ss, item, ',');)
-    if (!item.empty()) out.push_back(item);
-  return out;
 }
 
 nlohmann::json score_json(const orientation::TrackScore& s) {

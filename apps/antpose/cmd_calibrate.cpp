@@ -34,48 +34,42 @@ struct ImuArgs {
 void run_imu_device(const ImuArgs& args, const calibration::CalibrateImuOptions& options,
                     const store::DeviceRef& device) {
   if (!args.output.empty() && fs::exists(args.output) && !args.force)
-    throw InputError(args.output, "-o: exists; with --device the file receives the device's whole profile. Use "
-                                  "--force to replace it, or another name");
+    throw InputError(args.output,
+                     "-o: exists; with --device the file receives the device's whole profile. Use "
+                     "--force to replace it, or another name");
   nlohmann::json settings = {{"sensors", args.sensors}, {"method", args.method}, {"capture", args.capture}};
   if (args.gravity) settings["gravity_m_s2"] = *args.gravity;
   Diagnostics diagnostics;
-  try {
-    run_calibration(device, "imu", settings, {args.capture}, [&] {
-      const Capture capture = read_capture(args.capture, diagnostics);
-      if (capture.kind != "imu-calibration")
-        diagnostics.warn(args.capture, 0, fmt::format("capture kind is '{}', not 'imu-calibration'", capture.kind));
-      const auto result = calibration::calibrate_imu(capture, options, diagnostics, args.capture, device.profile.imu);
-      CalibrationOutcome outcome;
-      const auto& c = result.calibration;
-      outcome.residuals = {{"gravity_m_s2", result.gravity}, {"static_frames", result.frames.size()}};
-      if (c.acc_residual_rms_m_s2) outcome.residuals["acc_residual_rms_m_s2"] = *c.acc_residual_rms_m_s2;
-      if (c.gyro_residual_rms_deg) outcome.residuals["gyro_residual_rms_deg"] = *c.gyro_residual_rms_deg;
-      if (c.mag_residual_rel) outcome.residuals["mag_residual_rel"] = *c.mag_residual_rel;
-      if (c.mag_field_uT) outcome.residuals["mag_field_uT"] = *c.mag_field_uT;
-      outcome.apply = [imu = result.calibration](store::DeviceProfile& current) {
-        YAML::Node document = YAML::Clone(current.imu.document);
-        if (!document.IsMap()) document = YAML::Node(YAML::NodeType::Map);
-        if (imu.document.IsMap() && imu.document["imu"]) document["imu"] = YAML::Clone(imu.document["imu"]);
-        current.imu = imu;
-        current.imu.document = document;
-        current.imu.device_id = current.id;
-        current.has_imu = true;
-      };
-      print_warnings(diagnostics);
-      diagnostics = {};
-      fmt::print("IMU calibration of {} (method {})\n{}", args.capture, args.method, calibration::describe(result));
-      if (!args.output.empty()) {
-        store::DeviceProfile after = device.profile;
-        outcome.apply(after);
-        store::write_device_profile(after, args.output);
-        fmt::print("wrote {}\n", args.output);
-      }
-      return outcome;
-    });
-  } catch (...) {
-    print_warnings(diagnostics);
-    throw;
-  }
+  run_calibration(device, "imu", settings, {args.capture}, diagnostics, [&] {
+    const Capture capture = read_capture(args.capture, diagnostics);
+    if (capture.kind != "imu-calibration")
+      diagnostics.warn(args.capture, 0, fmt::format("capture kind is '{}', not 'imu-calibration'", capture.kind));
+    const auto result = calibration::calibrate_imu(capture, options, diagnostics, args.capture, device.profile.imu);
+    CalibrationOutcome outcome;
+    const auto& c = result.calibration;
+    outcome.residuals = {{"gravity_m_s2", result.gravity}, {"static_frames", result.frames.size()}};
+    if (c.acc_residual_rms_m_s2) outcome.residuals["acc_residual_rms_m_s2"] = *c.acc_residual_rms_m_s2;
+    if (c.gyro_residual_rms_deg) outcome.residuals["gyro_residual_rms_deg"] = *c.gyro_residual_rms_deg;
+    if (c.mag_residual_rel) outcome.residuals["mag_residual_rel"] = *c.mag_residual_rel;
+    if (c.mag_field_uT) outcome.residuals["mag_field_uT"] = *c.mag_field_uT;
+    outcome.apply = [imu = result.calibration](store::DeviceProfile& current) {
+      YAML::Node document = YAML::Clone(current.imu.document);
+      if (!document.IsMap()) document = YAML::Node(YAML::NodeType::Map);
+      if (imu.document.IsMap() && imu.document["imu"]) document["imu"] = YAML::Clone(imu.document["imu"]);
+      current.imu = imu;
+      current.imu.document = document;
+      current.imu.device_id = current.id;
+      current.has_imu = true;
+    };
+    fmt::print("IMU calibration of {} (method {})\n{}", args.capture, args.method, calibration::describe(result));
+    if (!args.output.empty()) {
+      store::DeviceProfile after = device.profile;
+      outcome.apply(after);
+      store::write_device_profile(after, args.output);
+      fmt::print("wrote {}\n", args.output);
+    }
+    return outcome;
+  });
 }
 
 void run_imu(const ImuArgs& args) {
@@ -94,8 +88,8 @@ void run_imu(const ImuArgs& args) {
     throw;
   }
   print_warnings(diagnostics);
-  fmt::print("IMU calibration of {} (method {})\n{}wrote {}\n", args.capture, args.method, calibration::describe(result),
-             args.output);
+  fmt::print("IMU calibration of {} (method {})\n{}wrote {}\n", args.capture, args.method,
+             calibration::describe(result), args.output);
 }
 
 struct AllanArgs {
@@ -128,7 +122,8 @@ void run_allan(const AllanArgs& args) {
                f.bias_instability_tau ? fmt::format("{:.2f}", *f.bias_instability_tau) : "-", opt(f.random_walk));
     nlohmann::json axis;
     axis["axis"] = a.axes[k];
-    for (const auto& p : a.curves[k]) axis["curve"].push_back({{"m", p.m}, {"tau_s", p.tau}, {"n", p.n}, {"oadev", p.deviation}});
+    for (const auto& p : a.curves[k])
+      axis["curve"].push_back({{"m", p.m}, {"tau_s", p.tau}, {"n", p.n}, {"oadev", p.deviation}});
     if (f.white) axis["white_noise"] = *f.white;
     if (f.bias_instability) axis["bias_instability"] = *f.bias_instability;
     if (f.bias_instability_tau) axis["bias_instability_tau_s"] = *f.bias_instability_tau;
@@ -138,7 +133,8 @@ void run_allan(const AllanArgs& args) {
   }
   if (!args.json.empty()) io::write_text_atomic(args.json, j.dump(2) + "\n");
   if (!args.plot.empty())
-    io::write_text_atomic(args.plot, calibration::allan_svg(series, "Overlapping Allan deviation: " + args.capture, unit));
+    io::write_text_atomic(args.plot,
+                          calibration::allan_svg(series, "Overlapping Allan deviation: " + args.capture, unit));
 }
 
 }  // namespace
@@ -150,17 +146,20 @@ void add_calibrate_command(CLI::App& app) {
   add_calibrate_joint_command(*cmd);
 
   auto imu_args = std::make_shared<ImuArgs>();
-  auto* imu = cmd->add_subcommand("imu", "accelerometer, gyroscope and magnetometer calibration from an "
-                                         "imu-calibration capture; writes the device YAML");
+  auto* imu = cmd->add_subcommand("imu",
+                                  "accelerometer, gyroscope and magnetometer calibration from an "
+                                  "imu-calibration capture; writes the device YAML");
   imu->add_option("capture", imu_args->capture, "imu-calibration capture folder")->required();
   imu->add_option("-o,--output", imu_args->output, "device calibration YAML to write (required without --device)");
   imu_args->device.add_to(*imu);
   imu->add_option("--sensors", imu_args->sensors, "comma-separated subset of acc,gyro,mag")->capture_default_str();
-  imu->add_option("--method", imu_args->method, "thesis (normalization, bias, hard iron) or full (9-parameter models, "
-                                                "ellipsoid)")
+  imu->add_option("--method", imu_args->method,
+                  "thesis (normalization, bias, hard iron) or full (9-parameter models, "
+                  "ellipsoid)")
       ->capture_default_str();
-  imu->add_option("--gravity", imu_args->gravity, "local gravity, m/s² (default: normal gravity at the capture's site, "
-                                                  "else 9.80665)");
+  imu->add_option("--gravity", imu_args->gravity,
+                  "local gravity, m/s² (default: normal gravity at the capture's site, "
+                  "else 9.80665)");
   imu->add_flag("--force", imu_args->force, "ignore (and replace) an existing output file instead of updating it");
   imu->callback([imu_args] { run_imu(*imu_args); });
 

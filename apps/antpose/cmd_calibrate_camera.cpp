@@ -35,7 +35,10 @@ nlohmann::json to_json(const camera::CameraCalibrationResult& r) {
   j["cy"] = in.cy;
   j["distortion"] = in.distortion;
   j["rms_px"] = r.rms_px;
-  j["sigma"] = {{"fx", r.sigma.fx}, {"fy", r.sigma.fy}, {"cx", r.sigma.cx}, {"cy", r.sigma.cy},
+  j["sigma"] = {{"fx", r.sigma.fx},
+                {"fy", r.sigma.fy},
+                {"cx", r.sigma.cx},
+                {"cy", r.sigma.cy},
                 {"distortion", r.sigma.distortion}};
   j["flags"] = r.flags;
   j["flag_names"] = r.flag_names;
@@ -78,50 +81,45 @@ void run_camera(const CameraArgs& args) {
   if (!args.config.empty()) run_settings["config"] = args.config;
   std::vector<fs::path> inputs{args.capture};
   if (!args.config.empty()) inputs.emplace_back(args.config);
-  try {
-    run_calibration(device, "camera", run_settings, inputs, [&] {
-      const auto result = camera::calibrate_camera(
-          fs::path(args.capture), settings, diagnostics,
-          [](const camera::CalibrationImage& im, std::size_t done, std::size_t total) {
-            fmt::print(stderr, "[{}/{}] {}: {}\n", done, total, im.image,
-                       im.points > 0 ? fmt::format("{} points", im.points) : im.reason);
-          });
-      print_warnings(diagnostics);
-      diagnostics = {};
-      fmt::print("camera calibration of {} ({} {}x{})\n{}", args.capture, camera::to_string(result.board.type),
-                 result.board.cols, result.board.rows, camera::describe(result));
-      if (!args.output.empty()) {
-        camera::write_camera_file(args.output, result, args.force);
-        fmt::print("wrote {}\n", args.output);
-      }
-      if (!args.json.empty()) io::write_text_atomic(args.json, to_json(result).dump(2) + "\n");
-      CalibrationOutcome outcome;
-      outcome.residuals = {{"rms_px", result.rms_px},
-                           {"photos_used", result.used_count()},
-                           {"photos", result.images.size()},
-                           {"flags", result.flag_names}};
-      for (const auto& [image, reason] : result.rejected()) outcome.residuals["rejected"].push_back({image, reason});
-      const auto pc = camera::profile_camera(result);
-      outcome.apply = [pc](store::DeviceProfile& current) {
-        current.camera = store::CameraCalibrationInfo{pc.intrinsics, pc.rms_px, pc.principal_point_sigma_px};
-      };
-      return outcome;
-    });
-  } catch (...) {
-    print_warnings(diagnostics);
-    throw;
-  }
+  run_calibration(device, "camera", run_settings, inputs, diagnostics, [&] {
+    const auto result =
+        camera::calibrate_camera(fs::path(args.capture), settings, diagnostics,
+                                 [](const camera::CalibrationImage& im, std::size_t done, std::size_t total) {
+                                   fmt::print(stderr, "[{}/{}] {}: {}\n", done, total, im.image,
+                                              im.points > 0 ? fmt::format("{} points", im.points) : im.reason);
+                                 });
+    fmt::print("camera calibration of {} ({} {}x{})\n{}", args.capture, camera::to_string(result.board.type),
+               result.board.cols, result.board.rows, camera::describe(result));
+    if (!args.output.empty()) {
+      camera::write_camera_file(args.output, result, args.force);
+      fmt::print("wrote {}\n", args.output);
+    }
+    if (!args.json.empty()) io::write_text_atomic(args.json, to_json(result).dump(2) + "\n");
+    CalibrationOutcome outcome;
+    outcome.residuals = {{"rms_px", result.rms_px},
+                         {"photos_used", result.used_count()},
+                         {"photos", result.images.size()},
+                         {"flags", result.flag_names}};
+    for (const auto& [image, reason] : result.rejected()) outcome.residuals["rejected"].push_back({image, reason});
+    const auto pc = camera::profile_camera(result);
+    outcome.apply = [pc](store::DeviceProfile& current) {
+      current.camera = store::CameraCalibrationInfo{pc.intrinsics, pc.rms_px, pc.principal_point_sigma_px};
+    };
+    return outcome;
+  });
 }
 
 }  // namespace
 
 void add_calibrate_camera_command(CLI::App& calibrate) {
   auto args = std::make_shared<CameraArgs>();
-  auto* cmd = calibrate.add_subcommand("camera", "intrinsic camera calibration from photos of a board "
-                                                 "(camera-calibration capture); writes an OpenCV camera YAML");
+  auto* cmd = calibrate.add_subcommand("camera",
+                                       "intrinsic camera calibration from photos of a board "
+                                       "(camera-calibration capture); writes an OpenCV camera YAML");
   cmd->add_option("capture", args->capture, "capture folder with shots.csv, images/ and board.yaml")->required();
-  cmd->add_option("--config", args->config, "settings: OpenCV calibration sample XML/YAML (<Settings>) or antpose "
-                                             "YAML; its board overrides board.yaml");
+  cmd->add_option("--config", args->config,
+                  "settings: OpenCV calibration sample XML/YAML (<Settings>) or antpose "
+                  "YAML; its board overrides board.yaml");
   cmd->add_flag("--fix-aspect-ratio", args->fix_aspect_ratio, "keep fx/fy fixed (1, or the config's/guess's ratio)");
   cmd->add_flag("--zero-tangent", args->zero_tangent, "assume zero tangential distortion (p1 = p2 = 0)");
   cmd->add_flag("--fix-principal-point", args->fix_principal_point,

@@ -5,7 +5,6 @@
 //       [--fixed-time-offset] [--json OUT]
 #include <filesystem>
 #include <memory>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -36,14 +35,6 @@ struct JointArgs {
   double time_offset = 0.0;
   bool fixed_time_offset = false;
 };
-
-std::vector<std::string> split_commas(const std::string& text) {
-  std::vector<std::string> out;
-  std::stringstream ss(text);
-  for (std::string item; std::getline(ss, item, ',');)
-    if (!item.empty()) out.push_back(item);
-  return out;
-}
 
 nlohmann::json matrix_json(const Mat3& R) {
   nlohmann::json j = nlohmann::json::array();
@@ -210,8 +201,6 @@ CalibrationOutcome joint_calibration(const JointArgs& args, const std::optional<
                            {"azimuth_error_deg", r.optimised.overall.azimuth_error_deg}};
     }
   }
-  print_warnings(diagnostics);
-  diagnostics = {};
   if (!args.json.empty()) io::write_text_atomic(args.json, j.dump(2) + "\n");
   if (!stored) throw MeasurementError("camera–IMU calibration: no method produced a result");
   outcome.apply = [c = *stored](store::DeviceProfile& current) { current.camera_imu = c; };
@@ -222,7 +211,7 @@ void run_joint(const JointArgs& args) {
   if (args.method != "reference-free" && args.method != "thesis" && args.method != "both")
     throw InputError("--method",
                      fmt::format("'{}' is not a method, expected reference-free, thesis or both", args.method));
-  const auto methods = split_commas(args.orientation);
+  const auto methods = split_list(args.orientation);
   if (methods.empty()) throw InputError("--orientation", "no orientation method given");
   const auto device = args.device.resolve();
   Diagnostics diagnostics;
@@ -235,13 +224,8 @@ void run_joint(const JointArgs& args) {
   if (!args.camera.empty()) settings["camera"] = args.camera;
   std::vector<fs::path> inputs{args.capture};
   if (!args.camera.empty()) inputs.emplace_back(args.camera);
-  try {
-    run_calibration(device, "camera-imu", settings, inputs,
-                    [&] { return joint_calibration(args, device, methods, diagnostics); });
-  } catch (...) {
-    print_warnings(diagnostics);
-    throw;
-  }
+  run_calibration(device, "camera-imu", settings, inputs, diagnostics,
+                  [&] { return joint_calibration(args, device, methods, diagnostics); });
 }
 
 }  // namespace

@@ -1,6 +1,9 @@
 // The CLI is a thin layer: each verb parses its options and calls the library.
 #pragma once
 
+#include <string>
+#include <vector>
+
 #include <CLI/CLI.hpp>
 
 #include "antpose/core/error.hpp"
@@ -23,5 +26,8 @@ void add_simulate_capture_command(CLI::App& simulate);
 
 /// Prints each warning as "warning: <file>:<line>: <message>" on stderr.
 void print_warnings(const Diagnostics& diagnostics);
+
+/// The non-empty items of a comma-separated option value ("a,b,,c" → a, b, c).
+std::vector<std::string> split_list(const std::string& text);
 
 }  // namespace antpose::cli

@@ -1,15 +1,17 @@
-// What the calibration verbs share for --device ID|FILE (docs/devices.md):
-// resolving it, and storing each run with its inputs' hashes, settings and
-// residuals, a failure included.
+// What the calibration verbs share for --device ID|FILE (docs/devices.md): resolving it, and
+// storing each run with its inputs' hashes, settings and residuals, a failure included.
 #pragma once
 
-#include <CLI/CLI.hpp>
 #include <filesystem>
 #include <functional>
-#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <vector>
 
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include "antpose/core/error.hpp"
 #include "antpose/store/device_ref.hpp"
 
 namespace antpose::cli {
@@ -29,12 +31,12 @@ struct CalibrationOutcome {
   std::function<void(store::DeviceProfile&)> apply;
 };
 
-/// Runs `calibrate`; with a device, stores the run (store::store_calibration)
-/// of `kind` with `settings` and the SHA-256 of every file of `inputs`, and
-/// prints where it went. An exception from `calibrate` is stored as a failed
-/// run (database devices; the profile is kept) and rethrown.
+/// Runs `calibrate`, then prints the warnings it left in `diagnostics` (also when it throws).
+/// With a device, stores the run (store::store_calibration) of `kind` with `settings` and the
+/// SHA-256 of every file of `inputs`, and prints where it went. An exception from `calibrate` is
+/// stored as a failed run (database devices; the profile is kept) and rethrown.
 void run_calibration(const std::optional<store::DeviceRef>& device, const std::string& kind,
                      const nlohmann::json& settings, const std::vector<std::filesystem::path>& inputs,
-                     const std::function<CalibrationOutcome()>& calibrate);
+                     Diagnostics& diagnostics, const std::function<CalibrationOutcome()>& calibrate);
 
 }  // namespace antpose::cli

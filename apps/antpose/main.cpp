@@ -2,6 +2,7 @@
 // 2 for bad input, 3 for a measurement that the data cannot support, 1 for anything else.
 #include <cstdio>
 #include <exception>
+#include <sstream>
 
 #include <fmt/core.h>
 
@@ -11,6 +12,14 @@ namespace antpose::cli {
 
 void print_warnings(const Diagnostics& diagnostics) {
   for (const auto& w : diagnostics.warnings()) fmt::print(stderr, "warning: {}\n", w.to_string());
+}
+
+std::vector<std::string> split_list(const std::string& text) {
+  std::vector<std::string> out;
+  std::stringstream ss(text);
+  for (std::string item; std::getline(ss, item, ',');)
+    if (!item.empty()) out.push_back(item);
+  return out;
 }
 
 }  // namespace antpose::cli

@@ -34,9 +34,10 @@ std::vector<bool> visible_from(const std::vector<Vec3>& points, const std::vecto
                                double bin_m, double depth_tolerance_m) {
   const std::size_t n = points.size();
   std::vector<bool> visible(n, false);
-  const Vec3 axis = (centroid(points) - viewpoint).normalized();
+  const Vec3 to_cloud = centroid(points) - viewpoint;
+  const Vec3 axis = to_cloud.normalized();
   const Vec3 u = axis.unitOrthogonal(), v = axis.cross(u);
-  const double bin_rad = bin_m / std::max((centroid(points) - viewpoint).norm(), 1e-6);
+  const double bin_rad = bin_m / std::max(to_cloud.norm(), 1e-6);
   std::map<std::pair<long, long>, double> nearest;
   std::vector<std::pair<long, long>> key(n);
   std::vector<double> range(n);

@@ -60,7 +60,10 @@ Eigen::Matrix<double, 3, 6> point_jacobian(const Vec3& p) {
   return J;
 }
 
-Sums accumulate(const PreparedCloud& source, const PreparedCloud& target, const Iso3& T, const IcpOptions& o) {
+/// One pass over the correspondences at T. Point-to-point needs JᵀWJ only for the result's
+/// information, so it is summed only when `information` is asked for.
+Sums accumulate(const PreparedCloud& source, const PreparedCloud& target, const Iso3& T, const IcpOptions& o,
+                bool information = false) {
   const double max_d2 = o.max_correspondence_distance_m * o.max_correspondence_distance_m;
   const auto& src = source.cloud.points;
   const auto& dst = target.cloud.points;
@@ -80,7 +83,7 @@ Sums accumulate(const PreparedCloud& source, const PreparedCloud& target, const 
             case IcpMethod::kPointToPoint: {
               const double w = kernel_weight(o.kernel, std::sqrt(d2), o.kernel_scale);
               s.w += w, s.sp += w * p, s.sq += w * q, s.spq += w * p * q.transpose();
-              s.H += w * J.transpose() * J;
+              if (information) s.H += w * J.transpose() * J;
               break;
             }
             case IcpMethod::kPointToPlane: {
@@ -183,7 +186,7 @@ IcpResult align(const PreparedCloud& source, const PreparedCloud& target, const 
   }
   T.linear() = nearest_rotation(T.linear());
   result.T_target_source = T;
-  const Sums s = accumulate(source, target, T, options);
+  const Sums s = accumulate(source, target, T, options, true);
   result.correspondences = s.pairs;
   result.fitness = static_cast<double>(s.pairs) / static_cast<double>(source.cloud.size());
   if (s.pairs > 0) result.rmse_m = std::sqrt(s.squared / static_cast<double>(s.pairs));
