@@ -22,7 +22,12 @@ struct CaptureOptions {
   std::uint64_t seed = 1;
   int width = 1600, height = 1200;
   int photos_per_placement = 12;
-  int photos = 20;
+  std::optional<int> photos;  // default 20, antenna 12
+  std::optional<std::uint64_t> device_seed;
+  std::string setting = "rooftop";
+  int antennas = 1;
+  bool disturbance = false;
+  std::string radome = "weathered";
   std::string board = "chessboard";
   int jpeg_quality = 92;
   double blur_px = 0.6;
@@ -34,8 +39,8 @@ struct CaptureOptions {
 };
 
 camera::BoardType board_type(const std::string& name) {
-  for (const auto t : {camera::BoardType::kChessboard, camera::BoardType::kCircles, camera::BoardType::kAsymmetricCircles,
-                       camera::BoardType::kCharuco})
+  for (const auto t : {camera::BoardType::kChessboard, camera::BoardType::kCircles,
+                       camera::BoardType::kAsymmetricCircles, camera::BoardType::kCharuco})
     if (camera::to_string(t) == name) return t;
   throw InputError("--board", fmt::format("'{}' is not chessboard, circles, asymmetric-circles or charuco", name));
 }
@@ -43,10 +48,17 @@ camera::BoardType board_type(const std::string& name) {
 void run(const CaptureOptions& o) {
   // Every value is checked here so that the message names the option.
   if (o.width < 64 || o.width > 8000) throw InputError("--width", fmt::format("{} px is outside 64..8000", o.width));
-  if (o.height < 64 || o.height > 8000) throw InputError("--height", fmt::format("{} px is outside 64..8000", o.height));
+  if (o.height < 64 || o.height > 8000)
+    throw InputError("--height", fmt::format("{} px is outside 64..8000", o.height));
   if (o.photos_per_placement < 2 || o.photos_per_placement > 100)
     throw InputError("--photos-per-placement", fmt::format("{} is outside 2..100", o.photos_per_placement));
-  if (o.photos < 3 || o.photos > 500) throw InputError("--photos", fmt::format("{} is outside 3..500", o.photos));
+  const bool antenna = o.scenario == "antenna";
+  const int photos = o.photos.value_or(antenna ? 12 : 20);
+  if (photos < 3 || photos > (antenna ? 60 : 500))
+    throw InputError("--photos", fmt::format("{} is outside 3..{}", photos, antenna ? 60 : 500));
+  if (o.antennas < 1 || o.antennas > 3) throw InputError("--antennas", fmt::format("{} is outside 1..3", o.antennas));
+  const sim::AntennaSetting setting = sim::parse_antenna_setting(o.setting);
+  const sim::RadomeLook radome = sim::parse_radome_look(o.radome);
   if (o.jpeg_quality < 1 || o.jpeg_quality > 100)
     throw InputError("--jpeg-quality", fmt::format("{} is outside 1..100", o.jpeg_quality));
   if (!(o.blur_px >= 0.0 && o.blur_px <= 20.0))
@@ -83,7 +95,12 @@ void run(const CaptureOptions& o) {
   if (o.time_offset_ms) sc.device.time_offset_s = *o.time_offset_ms * 1e-3;
   sc.board = sim::default_board(board_type(o.board));
   sc.photos_per_placement = o.photos_per_placement;
-  sc.photos = o.photos;
+  sc.photos = photos;
+  sc.device_seed = o.device_seed;
+  sc.setting = setting;
+  sc.antennas = o.antennas;
+  sc.disturbance = o.disturbance;
+  sc.radome = radome;
   const auto start = std::chrono::steady_clock::now();
   sc.progress = [&](int done, int total) {
     const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -92,13 +109,21 @@ void run(const CaptureOptions& o) {
     std::fflush(stderr);
   };
   const sim::SimulatedCapture sim = sim::write_simulated_capture(sc, out, overwrite);
-  const std::string subject = sc.scenario == sim::Scenario::kPlanes
-                                  ? std::string("the room")
-                                  : fmt::format("the board ({} {}x{})", o.board, sc.board.cols, sc.board.rows);
-  fmt::print("wrote {} ({}, seed {}): {} photos {}x{} of {}, {:.1f} s of IMU data; "
-             "time offset {:.1f} ms, camera mounting error {:.2f}°\n",
-             out.string(), o.scenario, o.seed, sim.shots.size(), o.width, o.height, subject,
-             sim.capture.truth_orientation->t.back(), sim.device.time_offset_s * 1e3, sim.device.mounting_error_deg);
+  std::string subject = sc.scenario == sim::Scenario::kPlanes
+                            ? std::string("the room")
+                            : fmt::format("the board ({} {}x{})", o.board, sc.board.cols, sc.board.rows);
+  if (sim.antenna) {
+    const auto& s0 = sim.antenna->layout.antennas.front();
+    subject =
+        fmt::format("{} antenna(s) on a {} mast{} (antenna-1 azimuth {:.1f}° magnetic, downtilt {:.1f}°)",
+                    sim.antenna->layout.antennas.size(), o.setting, sim.antenna->dipoles.empty() ? "" : ", magnetised",
+                    rad2deg(s0.azimuth_magnetic), rad2deg(s0.downtilt));
+  }
+  fmt::print(
+      "wrote {} ({}, seed {}): {} photos {}x{} of {}, {:.1f} s of IMU data; "
+      "time offset {:.1f} ms, camera mounting error {:.2f}°\n",
+      out.string(), o.scenario, o.seed, sim.shots.size(), o.width, o.height, subject,
+      sim.capture.truth_orientation->t.back(), sim.device.time_offset_s * 1e3, sim.device.mounting_error_deg);
 }
 
 }  // namespace
@@ -109,19 +134,36 @@ void add_simulate_capture_command(CLI::App& simulate) {
   auto o = std::make_shared<CaptureOptions>();
   cmd->add_option("-o,--output", o->output, "Capture folder to create")->required();
   cmd->add_flag("--force", o->force, "Replace an existing non-empty output folder");
-  cmd->add_option("--scenario", o->scenario,
-                  "camera-calibration: ~20 still views of a board (intrinsics); joint-calibration: six board placements, "
-                  "the phone walking around each (camera-IMU rotation and time offset); planes: no board, photos of the "
-                  "room's ground and walls while walking")
-      ->check(CLI::IsMember({"camera-calibration", "joint-calibration", "planes"}))
+  cmd->add_option(
+         "--scenario", o->scenario,
+         "camera-calibration: ~20 still views of a board (intrinsics); joint-calibration: six board placements, "
+         "the phone walking around each (camera-IMU rotation and time offset); planes: no board, photos of the "
+         "room's ground and walls while walking; antenna: a mast with panel antennas and a board on a tripod, "
+         "photographed while walking an arc (truth/scene.yaml: antenna attitudes and regions of interest)")
+      ->check(CLI::IsMember({"camera-calibration", "joint-calibration", "planes", "antenna"}))
       ->capture_default_str();
   cmd->add_option("--seed", o->seed, "Random seed (the same seed gives the same capture)")->capture_default_str();
   cmd->add_option("--width", o->width, "Image width, px (fx scales with it: 1300 px at 1600)")->capture_default_str();
   cmd->add_option("--height", o->height, "Image height, px")->capture_default_str();
   cmd->add_option("--photos-per-placement", o->photos_per_placement, "joint-calibration: photos per board placement")
       ->capture_default_str();
-  cmd->add_option("--photos", o->photos, "camera-calibration and planes: number of photos")->capture_default_str();
-  cmd->add_option("--board", o->board, "Board type: chessboard, circles, asymmetric-circles, charuco")->capture_default_str();
+  cmd->add_option("--photos", o->photos,
+                  "camera-calibration, planes (default 20) and antenna (default 12): number of photos");
+  cmd->add_option("--device-seed", o->device_seed,
+                  "Seed of the phone (intrinsics, R_device_camera, IMU errors, time offset); default --seed. The scene "
+                  "comes from --seed, so captures with one device seed share a phone calibrated once");
+  cmd->add_option("--setting", o->setting,
+                  "antenna: rooftop (antennas 3-12 m away) or ground (10-20 m up, 15-30 m away)")
+      ->capture_default_str();
+  cmd->add_option("--antennas", o->antennas, "antenna: number of panels on the mast, 1..3 (sectors ~120° apart)")
+      ->capture_default_str();
+  cmd->add_flag(
+      "--disturbance", o->disturbance,
+      "antenna: a magnetised steel mast (dipole line) turning magnetic north by 3-8° at the middle of the walk");
+  cmd->add_option("--radome", o->radome, "antenna: plain (uniform albedo) or weathered (dirt, streaks, label)")
+      ->capture_default_str();
+  cmd->add_option("--board", o->board, "Board type: chessboard, circles, asymmetric-circles, charuco")
+      ->capture_default_str();
   cmd->add_option("--jpeg-quality", o->jpeg_quality, "JPEG quality 1..100")->capture_default_str();
   cmd->add_option("--blur-px", o->blur_px, "Gaussian defocus σ, px")->capture_default_str();
   cmd->add_option("--noise", o->noise, "Sensor noise scale (1 = typical phone: photon + 3 e- read noise; 0 = none)")
@@ -132,7 +174,8 @@ void add_simulate_capture_command(CLI::App& simulate) {
   cmd->add_option("--phone", o->phone, "IMU error model: ideal, typical, random")
       ->check(CLI::IsMember({"ideal", "typical", "random"}))
       ->capture_default_str();
-  cmd->add_option("--supersampling", o->supersampling, "Ray samples per pixel side (anti-aliasing)")->capture_default_str();
+  cmd->add_option("--supersampling", o->supersampling, "Ray samples per pixel side (anti-aliasing)")
+      ->capture_default_str();
   cmd->callback([o] { run(*o); });
 }
 

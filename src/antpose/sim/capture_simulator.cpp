@@ -4,6 +4,8 @@
 #include <array>
 #include <cmath>
 #include <fstream>
+#include <limits>
+#include <memory>
 #include <numbers>
 #include <random>
 #include <stdexcept>
@@ -28,7 +30,9 @@ std::mt19937_64 make_rng(std::uint64_t seed, std::uint64_t stream) {
   return std::mt19937_64(seq);
 }
 
-double uniform(std::mt19937_64& rng, double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(rng); }
+double uniform(std::mt19937_64& rng, double lo, double hi) {
+  return std::uniform_real_distribution<double>(lo, hi)(rng);
+}
 
 Vec3 random_unit(std::mt19937_64& rng) {
   std::normal_distribution<double> n(0.0, 1.0);
@@ -44,7 +48,10 @@ Vec3 random_unit(std::mt19937_64& rng) {
 Mat3 rotation_between(const Vec3& a, const Vec3& b) {
   const Vec3 axis = a.cross(b);
   const double s = axis.norm(), c = a.dot(b);
-  if (s < 1e-12) return c > 0 ? Mat3::Identity() : exp_so3(std::numbers::pi * (std::abs(a.x()) < 0.9 ? a.cross(Vec3::UnitX()) : a.cross(Vec3::UnitY())).normalized());
+  if (s < 1e-12)
+    return c > 0 ? Mat3::Identity()
+                 : exp_so3(std::numbers::pi *
+                           (std::abs(a.x()) < 0.9 ? a.cross(Vec3::UnitX()) : a.cross(Vec3::UnitY())).normalized());
   return exp_so3(axis / s * std::atan2(s, c));
 }
 
@@ -80,7 +87,8 @@ bool board_in_view(const camera::CameraIntrinsics& K, const CameraPose& pose, co
       if (i != 0 && i != 8 && j != 0 && j != 8) continue;
       const Vec3 p_board(lo.x() - margin_m + (hi.x() - lo.x() + 2 * margin_m) * i / 8.0,
                          lo.y() - margin_m + (hi.y() - lo.y() + 2 * margin_m) * j / 8.0, 0.0);
-      const Vec3 p_camera = pose.R_world_camera.transpose() * (p_world_board + R_world_board * p_board - pose.p_world_camera);
+      const Vec3 p_camera =
+          pose.R_world_camera.transpose() * (p_world_board + R_world_board * p_board - pose.p_world_camera);
       if (p_camera.z() < 0.05) return false;
       // Outside the field of view by a wide margin: the distortion polynomial is meaningless there.
       const double x = p_camera.x() / p_camera.z(), y = p_camera.y() / p_camera.z();
@@ -128,15 +136,15 @@ constexpr double kMinJerkPeak = 1.875;
 constexpr double kMinRateDegS = 10.0, kMaxRateDegS = 40.0;
 
 struct PlannedPlacement {
-  std::vector<Waypoint> waypoints;   // N + 1
-  std::vector<double> durations;     // N moves
+  std::vector<Waypoint> waypoints;  // N + 1
+  std::vector<double> durations;    // N moves
 };
 
 // Waypoints of the walk around one placement: the camera on an arc around the nominal viewing
 // direction v0, looking at a point near the board centre, alternating roll so that every move
 // turns the phone by ≥ 10°; move durations give a peak (mid-move) rate of 15–32 °/s.
-PlannedPlacement plan_walk(const SimulatedDevice& d, const camera::BoardSpec& board, const BoardPlacement& pl, const Vec3& v0,
-                           int photos, std::mt19937_64& rng) {
+PlannedPlacement plan_walk(const SimulatedDevice& d, const camera::BoardSpec& board, const BoardPlacement& pl,
+                           const Vec3& v0, int photos, std::mt19937_64& rng) {
   const Vec3 centre = pl.p_world_board + pl.R_world_board * board_centre(board);
   const Vec3 up = Vec3::UnitZ();
   const Vec3 e1 = (std::abs(v0.dot(up)) < 0.95 ? up.cross(v0) : Vec3::UnitX().cross(v0)).normalized();
@@ -199,6 +207,132 @@ bool walk_admissible(const SimulatedDevice& d, const camera::BoardSpec& board, c
   return true;
 }
 
+// --- antenna scenario planning ----------------------------------------------------------------
+
+// World points that must be inside every photo: each panel's mesh vertices (brackets included).
+std::vector<Vec3> antenna_points(const AntennaLayout& layout) {
+  std::vector<Vec3> out;
+  for (const auto& a : layout.antennas)
+    for (const Vec3& v : model::builtin_panel(a.model_name).mesh_antenna.vertices)
+      out.push_back(a.p_world_antenna + a.R_world_antenna * v);
+  return out;
+}
+
+// The board's outline widened by `margin_m`, 9 points per side (edges bow with distortion).
+std::vector<Vec3> board_points(const camera::BoardSpec& board, const BoardPlacement& pl, double margin_m) {
+  const auto [lo, hi] = board.extent();
+  std::vector<Vec3> out;
+  for (int i = 0; i <= 8; ++i)
+    for (int j = 0; j <= 8; ++j) {
+      if (i != 0 && i != 8 && j != 0 && j != 8) continue;
+      const Vec3 p(lo.x() - margin_m + (hi.x() - lo.x() + 2 * margin_m) * i / 8.0,
+                   lo.y() - margin_m + (hi.y() - lo.y() + 2 * margin_m) * j / 8.0, 0.0);
+      out.push_back(pl.p_world_board + pl.R_world_board * p);
+    }
+  return out;
+}
+
+// Smallest distance (px) of the points' projections to the image border; −1 when one is behind
+// the camera or far outside the field of view (where the distortion polynomial means nothing).
+double fit_margin_px(const camera::CameraIntrinsics& K, const CameraPose& pose, const std::vector<Vec3>& points) {
+  double margin = std::numeric_limits<double>::infinity();
+  for (const Vec3& p : points) {
+    const Vec3 pc = pose.R_world_camera.transpose() * (p - pose.p_world_camera);
+    if (pc.z() < 0.05) return -1.0;
+    if (std::abs(pc.x() / pc.z()) > 1.5 * K.width / K.fx || std::abs(pc.y() / pc.z()) > 1.5 * K.height / K.fy)
+      return -1.0;
+    const auto uv = K.project(pc);
+    if (!uv) return -1.0;
+    margin = std::min({margin, uv->x(), uv->y(), K.width - 1 - uv->x(), K.height - 1 - uv->y()});
+  }
+  return margin;
+}
+
+// Camera at c looking so that the points' bounding box (undistorted normalised coordinates) is
+// centred in the image; image y along world down (landscape) or image x along world down
+// (portrait), plus a hand-held roll.
+Mat3 aim_camera(const Vec3& c, const std::vector<Vec3>& points, bool portrait, double roll) {
+  Vec3 f = Vec3::Zero();
+  for (const Vec3& p : points) f += (p - c).normalized();
+  Mat3 R = look_rotation(f, -Vec3::UnitZ(), roll + (portrait ? 0.5 * std::numbers::pi : 0.0));
+  for (int it = 0; it < 4; ++it) {
+    double x0 = std::numeric_limits<double>::infinity(), x1 = -x0, y0 = x0, y1 = -x0;
+    for (const Vec3& p : points) {
+      const Vec3 q = R.transpose() * (p - c);
+      if (q.z() <= 1e-3) return R;
+      x0 = std::min(x0, q.x() / q.z()), x1 = std::max(x1, q.x() / q.z());
+      y0 = std::min(y0, q.y() / q.z()), y1 = std::max(y1, q.y() / q.z());
+    }
+    R = R * rotation_between(Vec3::UnitZ(), Vec3(0.5 * (x0 + x1), 0.5 * (y0 + y1), 1.0).normalized());
+  }
+  return R;
+}
+
+camera::CameraIntrinsics scaled_intrinsics(const camera::CameraIntrinsics& K, int factor) {
+  camera::CameraIntrinsics s = K;
+  s.width = K.width / factor, s.height = K.height / factor;
+  s.fx = K.fx / factor, s.fy = K.fy / factor;
+  // Pixel centres at integers: u_small = (u + 0.5) / factor − 0.5.
+  s.cx = (K.cx + 0.5) / factor - 0.5, s.cy = (K.cy + 0.5) / factor - 0.5;
+  return s;
+}
+
+// The unoccluded fraction of each antenna's silhouette from `pose`, by id renders (scene, and
+// each panel alone) with a low-resolution renderer. Panel k is scene mesh `panel_mesh[k]`.
+std::vector<double> visible_fractions(const PhotoRenderer& low, const Scene& scene,
+                                      const std::vector<std::size_t>& panel_mesh, const CameraPose& pose) {
+  const Lighting lighting;
+  cv::Mat ids;
+  low.render(scene, pose, lighting, &ids);
+  std::vector<double> out;
+  for (const std::size_t m : panel_mesh) {
+    Scene alone;
+    alone.meshes.push_back(scene.meshes[m]);
+    cv::Mat alone_ids;
+    low.render(alone, pose, lighting, &alone_ids);
+    const int id = static_cast<int>(scene.patches.size() + m);
+    const double all = cv::countNonZero(alone_ids == 0);
+    const double seen = cv::countNonZero(ids == id);
+    out.push_back(all > 0 ? seen / all : 0.0);
+  }
+  return out;
+}
+
+// Tripod under a board: three legs from a head below the board's lower edge to the ground, and
+// a post up to the board.
+std::vector<MeshObject> tripod_meshes(const camera::BoardSpec& board, const BoardPlacement& pl, double ground_z) {
+  const auto [lo, hi] = board.extent();
+  // The lowest point of the board's outline (one square of margin) is where the head holds it.
+  Vec3 bottom = pl.p_world_board + pl.R_world_board * Vec3(0.5 * (lo.x() + hi.x()), lo.y() - board.square_m, 0.0);
+  const Vec3 other = pl.p_world_board + pl.R_world_board * Vec3(0.5 * (lo.x() + hi.x()), hi.y() + board.square_m, 0.0);
+  if (other.z() < bottom.z()) bottom = other;
+  const Vec3 n = pl.R_world_board.col(2);
+  const Vec3 head = bottom - Vec3(0.0, 0.0, 0.12) - 0.03 * Vec3(n.x(), n.y(), 0.0).normalized();
+  std::vector<MeshObject> out;
+  MeshObject post;
+  post.name = "tripod-post";
+  post.mesh = cylinder_mesh(head, bottom + Vec3(0.0, 0.0, 0.02), 0.015, 12);
+  post.albedo = 0.15;
+  out.push_back(post);
+  for (int k = 0; k < 3; ++k) {
+    const double a = 2.0 * std::numbers::pi * k / 3.0 + 0.3;
+    const Vec3 foot(head.x() + 0.55 * std::cos(a), head.y() + 0.55 * std::sin(a), ground_z);
+    MeshObject leg;
+    leg.name = fmt::format("tripod-leg-{}", k + 1);
+    leg.mesh = cylinder_mesh(head, foot, 0.012, 10);
+    leg.albedo = 0.15;
+    out.push_back(leg);
+  }
+  return out;
+}
+
+struct AntennaPlan {
+  BoardPlacement board;
+  std::vector<Waypoint> waypoints;  // one per photo
+  bool portrait = true;
+  double walk_azimuth = 0;  // of the walk's centre seen from the mast, rad
+};
+
 void write_binary(const fs::path& file, const std::string& bytes) {
   fs::create_directories(file.parent_path());
   std::ofstream out(file, std::ios::binary | std::ios::trunc);
@@ -223,10 +357,14 @@ SimulatedDevice make_device(const DeviceOptions& o, std::uint64_t seed) {
     throw std::invalid_argument(fmt::format("supersampling {} is outside 1..8", o.supersampling));
   auto rng = make_rng(seed, 0xde71ce);
   SimulatedDevice d;
-  if (o.phone == "ideal") d.phone = PhoneModel::ideal();
-  else if (o.phone == "typical") d.phone = PhoneModel::typical();
-  else if (o.phone == "random") d.phone = PhoneModel::random(rng);
-  else throw std::invalid_argument(fmt::format("phone '{}' is not ideal, typical or random", o.phone));
+  if (o.phone == "ideal")
+    d.phone = PhoneModel::ideal();
+  else if (o.phone == "typical")
+    d.phone = PhoneModel::typical();
+  else if (o.phone == "random")
+    d.phone = PhoneModel::random(rng);
+  else
+    throw std::invalid_argument(fmt::format("phone '{}' is not ideal, typical or random", o.phone));
 
   auto& K = d.intrinsics;
   K.width = o.width, K.height = o.height;
@@ -236,8 +374,8 @@ SimulatedDevice make_device(const DeviceOptions& o, std::uint64_t seed) {
   K.cy = 0.5 * (o.height - 1) + uniform(rng, -0.01, 0.01) * o.height;
   // A phone main camera after the ISP's own correction: mild residual barrel/pincushion terms,
   // monotonic over the image (1 + 3 k1 r² + 5 k2 r⁴ + 7 k3 r⁶ > 0 for r ≤ 0.8).
-  K.distortion = {0.10 * (1.0 + uniform(rng, -0.2, 0.2)), -0.25 * (1.0 + uniform(rng, -0.2, 0.2)), uniform(rng, -5e-4, 5e-4),
-                  uniform(rng, -5e-4, 5e-4), 0.12 * (1.0 + uniform(rng, -0.2, 0.2))};
+  K.distortion = {0.10 * (1.0 + uniform(rng, -0.2, 0.2)), -0.25 * (1.0 + uniform(rng, -0.2, 0.2)),
+                  uniform(rng, -5e-4, 5e-4), uniform(rng, -5e-4, 5e-4), 0.12 * (1.0 + uniform(rng, -0.2, 0.2))};
 
   const Vec3 axis = random_unit(rng);
   const double angle = deg2rad(uniform(rng, 1.0, 3.0));
@@ -257,9 +395,14 @@ SimulatedDevice make_device(const DeviceOptions& o, std::uint64_t seed) {
 
 std::string to_string(Scenario s) {
   switch (s) {
-    case Scenario::kCameraCalibration: return "camera-calibration";
-    case Scenario::kJointCalibration: return "joint-calibration";
-    case Scenario::kPlanes: return "planes";
+    case Scenario::kCameraCalibration:
+      return "camera-calibration";
+    case Scenario::kJointCalibration:
+      return "joint-calibration";
+    case Scenario::kPlanes:
+      return "planes";
+    case Scenario::kAntenna:
+      return "antenna";
   }
   return "unknown";
 }
@@ -268,15 +411,35 @@ Scenario parse_scenario(const std::string& name) {
   if (name == "camera-calibration") return Scenario::kCameraCalibration;
   if (name == "joint-calibration") return Scenario::kJointCalibration;
   if (name == "planes") return Scenario::kPlanes;
-  throw std::invalid_argument(fmt::format("scenario '{}' is not camera-calibration, joint-calibration or planes", name));
+  if (name == "antenna") return Scenario::kAntenna;
+  throw std::invalid_argument(
+      fmt::format("scenario '{}' is not camera-calibration, joint-calibration, planes or antenna", name));
 }
 
 camera::BoardSpec default_board(camera::BoardType type) {
   switch (type) {
-    case camera::BoardType::kChessboard: return {type, 9, 6, 0.03, 0.0, ""};
-    case camera::BoardType::kCircles: return {type, 7, 5, 0.04, 0.0, ""};
-    case camera::BoardType::kAsymmetricCircles: return {type, 4, 11, 0.03, 0.0, ""};
-    case camera::BoardType::kCharuco: return {type, 7, 5, 0.04, 0.03, "DICT_5X5_100"};
+    case camera::BoardType::kChessboard:
+      return {type, 9, 6, 0.03, 0.0, ""};
+    case camera::BoardType::kCircles:
+      return {type, 7, 5, 0.04, 0.0, ""};
+    case camera::BoardType::kAsymmetricCircles:
+      return {type, 4, 11, 0.03, 0.0, ""};
+    case camera::BoardType::kCharuco:
+      return {type, 7, 5, 0.04, 0.03, "DICT_5X5_100"};
+  }
+  return {};
+}
+
+camera::BoardSpec antenna_board(camera::BoardType type) {
+  switch (type) {
+    case camera::BoardType::kChessboard:
+      return {type, 9, 6, 0.07, 0.0, ""};
+    case camera::BoardType::kCircles:
+      return {type, 7, 5, 0.09, 0.0, ""};
+    case camera::BoardType::kAsymmetricCircles:
+      return {type, 4, 11, 0.07, 0.0, ""};
+    case camera::BoardType::kCharuco:
+      return {type, 7, 5, 0.09, 0.0675, "DICT_5X5_100"};
   }
   return {};
 }
@@ -294,8 +457,8 @@ std::vector<BoardPlacement> joint_placements(const camera::BoardSpec& board, dou
     Vec3 n_out, x_hint;
   };
   const std::array<Def, 6> defs{{
-      {"hor_0", up, horizontal(90.0)},            // face up, x towards magnetic east
-      {"hor_60", up, horizontal(150.0)},          // face up, turned 60°
+      {"hor_0", up, horizontal(90.0)},    // face up, x towards magnetic east
+      {"hor_60", up, horizontal(150.0)},  // face up, turned 60°
       {"tilt_20", facing(20.0, 200.0), right_of_viewer(facing(20.0, 200.0))},
       {"tilt_45", facing(45.0, 300.0), right_of_viewer(facing(45.0, 300.0))},
       {"vert_n", horizontal(0.0), right_of_viewer(horizontal(0.0))},    // upright, facing north
@@ -318,11 +481,21 @@ std::vector<BoardPlacement> joint_placements(const camera::BoardSpec& board, dou
 SimulatedCapture simulate_capture(const CaptureScenario& sc, const fs::path& scratch) {
   if (sc.photos_per_placement < 2 || sc.photos_per_placement > 100)
     throw std::invalid_argument(fmt::format("{} photos per placement is outside 2..100", sc.photos_per_placement));
-  if (sc.photos < 3 || sc.photos > 500) throw std::invalid_argument(fmt::format("{} photos is outside 3..500", sc.photos));
+  if (sc.photos < 3 || sc.photos > 500)
+    throw std::invalid_argument(fmt::format("{} photos is outside 3..500", sc.photos));
+  const bool antenna = sc.scenario == Scenario::kAntenna;
+  if (antenna && (sc.antennas < 1 || sc.antennas > 3))
+    throw InputError("--antennas", fmt::format("{} is outside 1..3", sc.antennas));
+  if (antenna && sc.photos > 60)
+    throw InputError("--photos", fmt::format("{} is outside 3..60 for the antenna scenario", sc.photos));
   SimulatedCapture out;
-  out.device = make_device(sc.device, sc.seed);
+  out.device = make_device(sc.device, sc.device_seed.value_or(sc.seed));
   const SimulatedDevice& d = out.device;
-  const camera::BoardSpec& board = sc.board;
+  // The calibration-sized default board is too small at 1.5–4 m: the antenna scenario's own.
+  const camera::BoardSpec default_of_type = default_board(sc.board.type);
+  const bool is_default = sc.board.cols == default_of_type.cols && sc.board.rows == default_of_type.rows &&
+                          sc.board.square_m == default_of_type.square_m;
+  const camera::BoardSpec board = antenna && is_default ? antenna_board(sc.board.type) : sc.board;
   const BoardTexture texture = board_texture(board);
 
   // Site and field: world = ENU with y along magnetic north.
@@ -358,7 +531,8 @@ SimulatedCapture simulate_capture(const CaptureScenario& sc, const fs::path& scr
         ok = walk_admissible(d, board, pl, plan);
       }
       if (!ok)
-        throw std::runtime_error(fmt::format("no admissible walk around placement {} (board too large for the camera?)", pl.name));
+        throw std::runtime_error(
+            fmt::format("no admissible walk around placement {} (board too large for the camera?)", pl.name));
       if (first) {
         tr = Trajectory(plan.waypoints.front().R_world_device, plan.waypoints.front().p_world_device);
         tr.hold(2.0);
@@ -373,6 +547,130 @@ SimulatedCapture simulate_capture(const CaptureScenario& sc, const fs::path& scr
       }
     }
     tr.hold(1.0);
+  } else if (antenna) {
+    // Draw the scene and the walk together; retry until every view fits (see AntennaPlan).
+    AntennaTruth at;
+    at.radome = sc.radome;
+    const bool roof = sc.setting == AntennaSetting::kRooftop;
+    const camera::CameraIntrinsics& K = d.intrinsics;
+    const int factor = std::max(1, std::min(K.width, K.height) / 200);
+    const PhotoRenderer low(scaled_intrinsics(K, factor), 1);
+    const int N = sc.photos;
+    const Vec3 up = Vec3::UnitZ();
+    AntennaPlan plan;
+    bool ok = false;
+    double half_site = 0.0;
+    for (int attempt = 0; attempt < 400 && !ok; ++attempt) {
+      at.layout = draw_antenna_layout(sc.setting, sc.antennas, rng);
+      // The walk: an arc around the mast at horizontal distance D, centred on azimuth phi0 (from
+      // the mast), spanning `span` of viewing directions; the board between walk and mast.
+      const double D = roof ? uniform(rng, 4.0, 10.0) : uniform(rng, 15.0, 30.0);
+      const double phi0 = uniform(rng, 0.0, 2.0 * std::numbers::pi);
+      const double hp = uniform(rng, 1.4, 1.7);
+      const Vec3 out_dir(std::sin(phi0), std::cos(phi0), 0.0);
+      const Vec3 C = D * out_dir + hp * up;
+      const double b = uniform(rng, 2.2, 3.4), lateral = uniform(rng, -0.3, 0.3);
+      const double zb = roof ? uniform(rng, 1.2, 1.6) : uniform(rng, 1.5, 1.9);
+      // The board stays within 4 m of the phone, which bounds the walk's half-length to
+      // sqrt(4² − b²) (less a margin for the jitter) and so the span at long range (ground).
+      const double s_max = std::sqrt(3.85 * 3.85 - b * b) - 0.35;
+      const double span_max =
+          std::min(2.0 * std::asin(std::min(1.0, s_max / D)), deg2rad(roof ? uniform(rng, 34.0, 40.0) : 26.0));
+      const double span_min = deg2rad(roof ? 25.0 : 10.0);
+      Vec3 Bc = C - b * out_dir + lateral * out_dir.cross(up);
+      Bc.z() = zb;
+      BoardPlacement pl;
+      pl.name = "tripod";
+      const Vec3 n_out = (C - Bc).normalized();  // facing the middle of the walk
+      pl.R_world_board = board_rotation(n_out, texture.face_normal_z, (-n_out).cross(up));
+      pl.p_world_board = Bc - pl.R_world_board * board_centre(board);
+      std::vector<Vec3> pts = antenna_points(at.layout);
+      const auto bpts = board_points(board, pl, 0.5 * board.square_m);
+      pts.insert(pts.end(), bpts.begin(), bpts.end());
+      // The widest span (in 2° steps) whose every view fits: the baseline matters most.
+      const double border = 0.04 * K.width;
+      std::vector<CameraPose> poses;
+      bool fine = false;
+      for (double span = span_max; span >= span_min && !fine; span -= deg2rad(2.0)) {
+        std::vector<Vec3> cs;
+        fine = true;
+        for (int k = 0; k < N && fine; ++k) {
+          const double psi = phi0 + span * (static_cast<double>(k) / (N - 1) - 0.5);
+          const double Dk = D + uniform(rng, -0.3, 0.3), hk = hp + uniform(rng, -0.05, 0.05);  // sequenced draws
+          const Vec3 c = Dk * Vec3(std::sin(psi), std::cos(psi), 0.0) + hk * up;
+          const double to_board = (c - Bc).norm();
+          fine = to_board >= 1.5 && to_board <= 4.0;
+          cs.push_back(c);
+        }
+        if (!fine) continue;
+        // Portrait or landscape, whichever leaves more room at the middle of the walk.
+        const Vec3& cm = cs[static_cast<std::size_t>(N / 2)];
+        double best = -1.0;
+        bool portrait = true;
+        for (const bool p : {true, false}) {
+          const double m = fit_margin_px(K, {aim_camera(cm, pts, p, 0.0), cm}, pts);
+          if (m > best) best = m, portrait = p;
+        }
+        fine = best >= border;
+        poses.clear();
+        plan.waypoints.clear();
+        for (int k = 0; k < N && fine; ++k) {
+          const Vec3& c = cs[static_cast<std::size_t>(k)];
+          const CameraPose pose{aim_camera(c, pts, portrait, deg2rad(uniform(rng, -4.0, 4.0))), c};
+          fine = fit_margin_px(K, pose, pts) >= border;
+          poses.push_back(pose);
+          plan.waypoints.push_back(device_from_camera(d, pose.R_world_camera, c));
+        }
+        plan.portrait = portrait;
+      }
+      if (!fine) continue;
+      // Every antenna mostly unoccluded (by the mast, the other panels, the board) in every view.
+      half_site = D + 6.0;
+      // (The site's patches cannot hide a panel: the phone stands on the roof or the ground below
+      // it; leaving them out saves drawing their textures for every attempt.)
+      Scene check;
+      check.patches.push_back(board_patch(texture, pl.R_world_board, pl.p_world_board, "board"));
+      check.meshes = antenna_meshes(at.layout, RadomeLook::kPlain, sc.seed);
+      std::vector<std::size_t> panel_mesh;
+      for (std::size_t k = 0; k < at.layout.antennas.size(); ++k) panel_mesh.push_back(1 + 5 * k);
+      for (const auto& pose : poses) {
+        for (const double f : visible_fractions(low, check, panel_mesh, pose)) fine = fine && f >= 0.6;
+        if (!fine) break;
+      }
+      if (!fine) continue;
+      plan.board = pl;
+      plan.walk_azimuth = phi0;
+      ok = true;
+    }
+    if (!ok)
+      throw std::runtime_error(fmt::format(
+          "no admissible antenna scene and walk for {} photos of {}x{} px (image too small?)", N, K.width, K.height));
+    out.placements.push_back(plan.board);
+    out.meshes = antenna_meshes(at.layout, sc.radome, sc.seed);
+    const auto tripod = tripod_meshes(board, plan.board, 0.0);
+    out.meshes.insert(out.meshes.end(), tripod.begin(), tripod.end());
+    out.surfaces = antenna_site_patches(at.layout, half_site, sc.seed);
+    // Still for 3 s (first photo in it), then walk: each move at a hand-held pace (≤ 25 °/s
+    // mean turn, ≤ 0.8 m/s), a 0.7 s pause, the photo in the middle of the pause.
+    const auto& wp = plan.waypoints;
+    tr = Trajectory(wp.front().R_world_device, wp.front().p_world_device);
+    tr.hold(3.0);
+    shot_times.emplace_back(2.6, 0);
+    for (std::size_t k = 1; k < wp.size(); ++k) {
+      const double angle = rad2deg(rotation_distance(wp[k - 1].R_world_device, wp[k].R_world_device));
+      const double distance = (wp[k].p_world_device - wp[k - 1].p_world_device).norm();
+      const double T = std::clamp(std::max(kMinJerkPeak * angle / 25.0, kMinJerkPeak * distance / 0.8), 1.0, 4.0);
+      tr.move_to(wp[k].R_world_device, wp[k].p_world_device, T);
+      shot_times.emplace_back(tr.duration() + 0.35, 0);
+      tr.hold(0.7);
+    }
+    tr.hold(1.5);
+    if (sc.disturbance) {
+      // Magnetic north turned by 3–8° (either way) at the middle of the walk.
+      const double target = deg2rad(uniform(rng, 3.0, 8.0)) * (uniform(rng, 0.0, 1.0) < 0.5 ? -1.0 : 1.0);
+      at.dipoles = mast_dipoles(at.layout, field_world_uT, wp[wp.size() / 2].p_world_device, target, rng);
+    }
+    out.antenna = at;
   } else if (!has_board) {
     // A walk through the room: positions at least 2 m from the walls, looking at a wall or at
     // the ground 1–3 m ahead, each move turning the phone at a hand-held rate.
@@ -384,7 +682,8 @@ SimulatedCapture simulate_capture(const CaptureScenario& sc, const fs::path& scr
       const Vec3 ahead(std::sin(heading), std::cos(heading), 0.0);
       const bool ground = uniform(rng, 0.0, 1.0) < 0.4;
       const double reach = uniform(rng, 1.0, 3.0), height = uniform(rng, 0.3, 2.7);
-      const Vec3 target = ground ? Vec3(c + reach * ahead - Vec3(0.0, 0.0, z)) : Vec3(c + 8.0 * ahead + Vec3(0.0, 0.0, height - z));
+      const Vec3 target =
+          ground ? Vec3(c + reach * ahead - Vec3(0.0, 0.0, z)) : Vec3(c + 8.0 * ahead + Vec3(0.0, 0.0, height - z));
       const double roll = deg2rad(uniform(rng, -10.0, 10.0));
       poses.push_back(device_from_camera(d, look_rotation(target - c, -Vec3::UnitZ(), roll), c));
     }
@@ -393,7 +692,8 @@ SimulatedCapture simulate_capture(const CaptureScenario& sc, const fs::path& scr
     for (std::size_t k = 1; k < poses.size(); ++k) {
       const double angle = rad2deg(rotation_distance(poses[k - 1].R_world_device, poses[k].R_world_device));
       const double distance = (poses[k].p_world_device - poses[k - 1].p_world_device).norm();
-      const double T = std::clamp(std::max(kMinJerkPeak * angle / uniform(rng, 15.0, 32.0), kMinJerkPeak * distance / 1.2), 0.6, 6.0);
+      const double T = std::clamp(
+          std::max(kMinJerkPeak * angle / uniform(rng, 15.0, 32.0), kMinJerkPeak * distance / 1.2), 0.6, 6.0);
       shot_times.emplace_back(tr.duration() + 0.5 * T, 0);
       tr.move_to(poses[k].R_world_device, poses[k].p_world_device, T);
     }
@@ -438,7 +738,9 @@ SimulatedCapture simulate_capture(const CaptureScenario& sc, const fs::path& scr
         poses.push_back(device_from_camera(d, R_world_camera, c));
         ok = true;
       }
-      if (!ok) throw std::runtime_error(fmt::format("no admissible view {} of the board (board too large for the camera?)", k));
+      if (!ok)
+        throw std::runtime_error(
+            fmt::format("no admissible view {} of the board (board too large for the camera?)", k));
     }
     tr = Trajectory(poses.front().R_world_device, poses.front().p_world_device);
     for (std::size_t k = 0; k < poses.size(); ++k) {
@@ -461,6 +763,7 @@ SimulatedCapture simulate_capture(const CaptureScenario& sc, const fs::path& scr
   imu.kind = has_board ? to_string(sc.scenario) : "imu-log";  // no capture kind for "photos of a room" yet
   imu.truth_world = "enu-magnetic";
   imu.seed = sc.seed;
+  if (out.antenna) imu.dipoles = out.antenna->dipoles;
   out.capture = simulate_imu(imu);
   Capture& c = out.capture;
   c.root = scratch;
@@ -468,10 +771,24 @@ SimulatedCapture simulate_capture(const CaptureScenario& sc, const fs::path& scr
   // Photos.
   fs::create_directories(scratch / "images");
   const PhotoRenderer renderer(d.intrinsics, d.supersampling);
-  out.surfaces = room_patches(sc.seed);
+  if (!antenna) out.surfaces = room_patches(sc.seed);
   const auto& room = out.surfaces;
-  std::vector<TexturedPatch> scene_patches;
+  Scene scene;
+  scene.meshes = out.meshes;
   const Lighting lighting;
+  std::vector<Vec3> antenna_pts;
+  std::vector<std::size_t> panel_mesh;
+  std::unique_ptr<PhotoRenderer> low;
+  if (antenna) {
+    antenna_pts = antenna_points(out.antenna->layout);
+    const auto bpts = board_points(board, out.placements.front(), 0.0);
+    antenna_pts.insert(antenna_pts.end(), bpts.begin(), bpts.end());
+    for (std::size_t k = 0; k < out.antenna->layout.antennas.size(); ++k) panel_mesh.push_back(1 + 5 * k);
+    low = std::make_unique<PhotoRenderer>(
+        scaled_intrinsics(d.intrinsics, std::max(1, std::min(d.intrinsics.width, d.intrinsics.height) / 200)), 1);
+    out.antenna->visible_fraction.assign(panel_mesh.size(), {});
+    out.antenna->roi_shot = static_cast<int>(shot_times.size() / 2);
+  }
   const int total = static_cast<int>(shot_times.size());
   if (joint) c.shot_extra_columns = {"placement"};
   for (int i = 0; i < total; ++i) {
@@ -497,9 +814,35 @@ SimulatedCapture simulate_capture(const CaptureScenario& sc, const fs::path& scr
       throw std::runtime_error(fmt::format("internal: photo {} taken at {:.1f} °/s, outside {}..{} °/s", i,
                                            st.angular_rate_deg_s, kMinRateDegS, kMaxRateDegS));
 
-    scene_patches = room;
-    if (pl) scene_patches.push_back(board_patch(texture, pl->R_world_board, pl->p_world_board, "board " + pl->name));
-    cv::Mat radiance = renderer.render(scene_patches, pose, lighting);
+    if (antenna && fit_margin_px(d.intrinsics, pose, antenna_pts) < 2.0)
+      throw std::runtime_error(fmt::format("internal: photo {} does not show the whole board and every antenna", i));
+
+    scene.patches = room;
+    if (pl) scene.patches.push_back(board_patch(texture, pl->R_world_board, pl->p_world_board, "board " + pl->name));
+    cv::Mat radiance = renderer.render(scene, pose, lighting);
+    if (antenna) {
+      AntennaTruth& at = *out.antenna;
+      at.north_shift.push_back(north_shift(at.dipoles, field_world_uT, st.p_world_device));
+      const auto fractions = visible_fractions(*low, scene, panel_mesh, pose);
+      for (std::size_t k = 0; k < fractions.size(); ++k) at.visible_fraction[k].push_back(fractions[k]);
+      if (i == at.roi_shot)
+        for (const auto& a : at.layout.antennas) {
+          // Bounding box of the projected mesh vertices, widened by 5 % of its size (at least
+          // 8 px: straight edges bow a little between vertices under distortion), clipped.
+          double u0 = std::numeric_limits<double>::infinity(), u1 = -u0, v0 = u0, v1 = -u0;
+          for (const Vec3& v : model::builtin_panel(a.model_name).mesh_antenna.vertices)
+            if (const auto uv = project_world(d.intrinsics, pose, a.p_world_antenna + a.R_world_antenna * v)) {
+              u0 = std::min(u0, uv->x()), u1 = std::max(u1, uv->x()), v0 = std::min(v0, uv->y()),
+              v1 = std::max(v1, uv->y());
+            }
+          const double m = std::max(8.0, 0.05 * std::max(u1 - u0, v1 - v0));
+          const int x0 = std::max(0, static_cast<int>(std::floor(u0 - m))),
+                    y0 = std::max(0, static_cast<int>(std::floor(v0 - m)));
+          const int x1 = std::min(d.intrinsics.width, static_cast<int>(std::ceil(u1 + m)) + 1);
+          const int y1 = std::min(d.intrinsics.height, static_cast<int>(std::ceil(v1 + m)) + 1);
+          at.roi.emplace_back(x0, y0, x1 - x0, y1 - y0);
+        }
+    }
     radiance = motion_blur(radiance, d.intrinsics, d.R_device_camera.transpose() * omega_device, d.sensor.exposure_s);
     const cv::Mat grey = sensor_image(radiance, d.sensor, sc.seed * 1000003ULL + static_cast<std::uint64_t>(i) + 1);
     const fs::path file = scratch / st.image;
@@ -514,6 +857,21 @@ SimulatedCapture simulate_capture(const CaptureScenario& sc, const fs::path& scr
     c.shots.push_back(shot);
     out.shots.push_back(st);
     if (sc.progress) sc.progress(i + 1, total);
+  }
+
+  if (antenna) {
+    // Baseline for triangulation: the largest angle between two viewing directions of each antenna.
+    AntennaTruth& at = *out.antenna;
+    for (const auto& a : at.layout.antennas) {
+      double span = 0.0;
+      for (const auto& s1 : out.shots)
+        for (const auto& s2 : out.shots) {
+          const Vec3 u = (a.p_world_antenna - s1.p_world_camera).normalized(),
+                     v = (a.p_world_antenna - s2.p_world_camera).normalized();
+          span = std::max(span, std::atan2(u.cross(v).norm(), u.dot(v)));
+        }
+      at.viewing_span_deg.push_back(rad2deg(span));
+    }
   }
 
   // Truth and calibration files.
@@ -593,8 +951,9 @@ std::string capture_device_yaml(const SimulatedDevice& d, const ImuSimulation& i
     Vec3 k;
     calibration::canonical_accelerometer((a.misalignment * a.scale.asDiagonal()).inverse(), T, k, &Q);
     ci["R_calibrated_camera"] = yaml_flow_matrix(Q.transpose() * d.R_device_camera);
-    ci["calibrated_frame"] = "the device frame as an IMU calibration defines it (x along the accelerometer's x axis, y "
-                             "in its xy plane): R_calibrated_camera = R_device_calibratedᵀ R_device_camera";
+    ci["calibrated_frame"] =
+        "the device frame as an IMU calibration defines it (x along the accelerometer's x axis, y "
+        "in its xy plane): R_calibrated_camera = R_device_calibratedᵀ R_device_camera";
   }
   ci["p_device_camera_m"] = yaml_flow_vector(d.p_device_camera);
   ci["time_offset_s"] = num(d.time_offset_s);
@@ -619,7 +978,8 @@ std::string capture_scene_yaml(const SimulatedCapture& sim, const camera::BoardS
   YAML::Node root;
   root["world"] = "enu-magnetic";
   root["declination_deg"] = num(sim.declination_deg);
-  root["note"] = "true azimuth = magnetic azimuth + declination; rotations as rows; board frame of board.yaml (camera/board.hpp)";
+  root["note"] =
+      "true azimuth = magnetic azimuth + declination; rotations as rows; board frame of board.yaml (camera/board.hpp)";
   if (!sim.placements.empty()) {
     YAML::Node b;
     b["type"] = camera::to_string(board.type);
@@ -647,6 +1007,88 @@ std::string capture_scene_yaml(const SimulatedCapture& sim, const camera::BoardS
     span.SetStyle(YAML::EmitterStyle::Flow);
     n["shots_t_true"] = span;
     root["placements"].push_back(n);
+  }
+  if (sim.antenna) {
+    const AntennaTruth& at = *sim.antenna;
+    const double decl = deg2rad(sim.declination_deg);
+    root["setting"] = to_string(at.layout.setting);
+    YAML::Node mast;
+    mast["p_world_base_m"] = yaml_flow_vector(Vec3::Zero());
+    mast["radius_m"] = num(at.layout.mast_radius_m);
+    mast["height_m"] = num(at.layout.mast_top_m);
+    if (at.layout.setting == AntennaSetting::kRooftop) mast["roof_above_street_m"] = num(at.layout.building_height_m);
+    root["mast"] = mast;
+    for (std::size_t k = 0; k < at.layout.antennas.size(); ++k) {
+      const SimAntenna& a = at.layout.antennas[k];
+      YAML::Node n;
+      n["name"] = a.name;
+      n["model"] = a.model_name;
+      YAML::Node spec;
+      spec["width_m"] = num(a.spec.width_m);
+      spec["depth_m"] = num(a.spec.depth_m);
+      spec["height_m"] = num(a.spec.height_m);
+      spec["edge_radius_m"] = num(a.spec.edge_radius_m);
+      spec["bracket"] = a.spec.bracket;
+      spec["bracket_width_m"] = num(a.spec.bracket_width_m);
+      spec["bracket_depth_m"] = num(a.spec.bracket_depth_m);
+      spec["bracket_height_m"] = num(a.spec.bracket_height_m);
+      spec["arc_segments"] = a.spec.arc_segments;
+      n["panel"] = spec;
+      n["R_world_antenna"] = yaml_flow_matrix(a.R_world_antenna);
+      n["p_world_antenna_m"] = yaml_flow_vector(a.p_world_antenna);
+      n["azimuth_magnetic_deg"] = num(rad2deg(a.azimuth_magnetic));
+      n["azimuth_true_deg"] = num(rad2deg(wrap_2pi(a.azimuth_magnetic + decl)));
+      n["downtilt_deg"] = num(rad2deg(a.downtilt));
+      n["roll_deg"] = num(rad2deg(a.roll));
+      n["radome"] = to_string(at.radome);
+      if (k < at.roi.size()) {
+        YAML::Node roi;
+        roi["image"] = sim.shots.at(static_cast<std::size_t>(at.roi_shot)).image;
+        roi["x"] = at.roi[k].x;
+        roi["y"] = at.roi[k].y;
+        roi["width"] = at.roi[k].width;
+        roi["height"] = at.roi[k].height;
+        roi.SetStyle(YAML::EmitterStyle::Flow);
+        n["roi"] = roi;
+      }
+      if (k < at.viewing_span_deg.size()) n["viewing_span_deg"] = num(at.viewing_span_deg[k]);
+      if (k < at.visible_fraction.size()) {
+        YAML::Node vis;
+        for (const double f : at.visible_fraction[k]) vis.push_back(io::format_number(std::round(f * 1000.0) / 1000.0));
+        vis.SetStyle(YAML::EmitterStyle::Flow);
+        n["visible_fraction"] = vis;
+      }
+      root["antennas"].push_back(n);
+    }
+    YAML::Node dist;
+    if (at.dipoles.empty()) {
+      dist["model"] = "none";
+    } else {
+      dist["model"] = "dipole-line";
+      dist["description"] =
+          "a magnetised steel mast: equal point dipoles on its axis, B = 1e-7 (3 r^ (r^.m) - m) / |r|^3 T, "
+          "evaluated at the phone (device origin); also in truth/device.yaml dipoles";
+      for (const auto& dp : at.dipoles) {
+        YAML::Node n;
+        n["p_world_m"] = yaml_flow_vector(dp.p_world);
+        n["moment_Am2"] = yaml_flow_vector(dp.moment_Am2);
+        dist["dipoles"].push_back(n);
+      }
+    }
+    dist["north_shift_definition"] =
+        "clockwise turn of the horizontal field at the phone, deg; a magnetometer heading is too "
+        "small by it: heading_error_deg = -north_shift_deg";
+    YAML::Node shift, err;
+    for (const double v : at.north_shift) {
+      shift.push_back(io::format_number(std::round(rad2deg(v) * 1e4) / 1e4));
+      err.push_back(io::format_number(std::round(-rad2deg(v) * 1e4) / 1e4 + 0.0));  // no "-0"
+    }
+    shift.SetStyle(YAML::EmitterStyle::Flow);
+    err.SetStyle(YAML::EmitterStyle::Flow);
+    dist["north_shift_deg"] = shift;
+    dist["heading_error_deg"] = err;
+    root["disturbance"] = dist;
+    for (const auto& m : sim.meshes) root["objects"].push_back(m.name);
   }
   for (const auto& p : sim.surfaces) {
     YAML::Node n;

@@ -28,7 +28,14 @@
 //                       magnetic north) readings with uniform errors within ±0.2° and ±1.5°.
 //   planes              no board: the phone walks through the room (ground and four walls,
 //                       the planar patches of room_patches) photographing walls and ground
-//                       mid-move; kind imu-log. A base for later issues (3-D objects).
+//                       mid-move; kind imu-log.
+//   antenna             a mast with 1–3 panel antennas (antenna_scene.hpp) on a roof or on open
+//                       ground, a large board on a tripod 1.5–4 m from the phone; the phone
+//                       walks an arc around the mast pausing for each photo, every photo showing
+//                       the whole board and every antenna (≥ 60 % unoccluded). The arc is the
+//                       widest that keeps both in view: 27–37° of viewing directions on a roof,
+//                       only 8–13° on the ground (the 4 m board limit bounds the walk to ±2–3 m
+//                       at 20–33 m range); optional magnetised-mast disturbance.
 // Every truth/scene.yaml lists the room's planes, so photos can be re-rendered or scored.
 #pragma once
 
@@ -42,6 +49,7 @@
 #include "antpose/camera/board.hpp"
 #include "antpose/camera/camera_model.hpp"
 #include "antpose/io/capture.hpp"
+#include "antpose/sim/antenna_scene.hpp"
 #include "antpose/sim/imu_simulator.hpp"
 #include "antpose/sim/photo_simulator.hpp"
 
@@ -60,9 +68,9 @@ struct SimulatedDevice {
 };
 
 struct DeviceOptions {
-  int width = 1600, height = 1200;        // px; fx scales with the width (1300 px at 1600)
-  std::string phone = "typical";          // ideal | typical | random (PhoneModel)
-  std::optional<double> time_offset_s;    // fixed; default uniform in [10, 60] ms
+  int width = 1600, height = 1200;      // px; fx scales with the width (1300 px at 1600)
+  std::string phone = "typical";        // ideal | typical | random (PhoneModel)
+  std::optional<double> time_offset_s;  // fixed; default uniform in [10, 60] ms
   double blur_sigma_px = 0.6;
   double noise_scale = 1.0;
   double exposure_s = 0.002;
@@ -74,9 +82,9 @@ struct DeviceOptions {
 /// unknown phone, a JPEG quality outside 1..100, negative blur/noise/exposure.
 SimulatedDevice make_device(const DeviceOptions& options, std::uint64_t seed);
 
-enum class Scenario { kCameraCalibration, kJointCalibration, kPlanes };
+enum class Scenario { kCameraCalibration, kJointCalibration, kPlanes, kAntenna };
 std::string to_string(Scenario scenario);
-/// "camera-calibration" | "joint-calibration" | "planes"; std::invalid_argument otherwise.
+/// "camera-calibration" | "joint-calibration" | "planes" | "antenna"; std::invalid_argument otherwise.
 Scenario parse_scenario(const std::string& name);
 
 /// A board placement of the joint-calibration scenario.
@@ -95,14 +103,24 @@ std::vector<BoardPlacement> joint_placements(const camera::BoardSpec& board, dou
 /// circles 7 × 5, 40 mm; asymmetric-circles 4 × 11, 30 mm; charuco 7 × 5 squares of 40 mm with
 /// 30 mm DICT_5X5_100 markers.
 camera::BoardSpec default_board(camera::BoardType type);
+/// The boards of the antenna scenario, seen from 1.5–4 m: chessboard 9 × 6 of 70 mm; circles
+/// 7 × 5 at 90 mm; asymmetric-circles 4 × 11 at 70 mm; charuco 7 × 5 of 90 mm, 67.5 mm markers.
+/// The antenna scenario uses it when CaptureScenario::board is default_board of its type.
+camera::BoardSpec antenna_board(camera::BoardType type);
 
 struct CaptureScenario {
   Scenario scenario = Scenario::kJointCalibration;
   std::uint64_t seed = 1;
   DeviceOptions device;
   camera::BoardSpec board = default_board(camera::BoardType::kChessboard);
-  int photos_per_placement = 12;       // joint-calibration
-  int photos = 20;                     // camera-calibration, planes
+  int photos_per_placement = 12;  // joint-calibration
+  int photos = 20;                // camera-calibration, planes, antenna (the CLI's default there: 12)
+  /// Seed of the phone (make_device); default = seed. One phone can take many scenes.
+  std::optional<std::uint64_t> device_seed;
+  AntennaSetting setting = AntennaSetting::kRooftop;  // antenna
+  int antennas = 1;                                   // antenna: 1..3
+  bool disturbance = false;                           // antenna: magnetised mast (antenna_scene.hpp)
+  RadomeLook radome = RadomeLook::kWeathered;         // antenna
   Site site{30.26, 120.12, 20.0, "2025-06-01"};
   /// Called after each photo with (photos done, photos in all).
   std::function<void(int, int)> progress;
@@ -112,13 +130,25 @@ struct CaptureScenario {
 struct ShotTruth {
   int index = 0;
   std::string image, placement;
-  double t_true = 0.0;              // IMU clock, s
-  double t_shot = 0.0;              // shots.csv t = t_true − time_offset_s
+  double t_true = 0.0;  // IMU clock, s
+  double t_shot = 0.0;  // shots.csv t = t_true − time_offset_s
   Mat3 R_world_device = Mat3::Identity();
   Vec3 p_world_device = Vec3::Zero();
   Mat3 R_world_camera = Mat3::Identity();
   Vec3 p_world_camera = Vec3::Zero();
   double angular_rate_deg_s = 0.0;  // |ω| at t_true
+};
+
+/// Truth of the antenna scenario.
+struct AntennaTruth {
+  AntennaLayout layout;
+  RadomeLook radome = RadomeLook::kWeathered;
+  std::vector<MagneticDipole> dipoles;                // empty without disturbance
+  std::vector<double> north_shift;                    // per shot, rad (north_shift in antenna_scene.hpp)
+  int roi_shot = 0;                                   // the photo the regions of interest are in (the middle one)
+  std::vector<cv::Rect> roi;                          // per antenna: its projection's bounding box + margin, clipped
+  std::vector<std::vector<double>> visible_fraction;  // [antenna][shot]: unoccluded part of its silhouette
+  std::vector<double> viewing_span_deg;               // per antenna: largest angle between two viewing directions
 };
 
 struct SimulatedCapture {
@@ -128,6 +158,8 @@ struct SimulatedCapture {
   std::vector<TexturedPatch> surfaces;     // the room (ground, walls)
   std::vector<ShotTruth> shots;
   double declination_deg = 0.0;
+  std::optional<AntennaTruth> antenna;  // antenna scenario
+  std::vector<MeshObject> meshes;       // antenna scenario: mast, panels, arms, clamps, tripod
 };
 
 /// Runs a scenario; photos are written as JPEG into `scratch` (created), which write_capture
@@ -137,7 +169,8 @@ SimulatedCapture simulate_capture(const CaptureScenario& scenario, const std::fi
 
 /// simulate_capture into a scratch folder next to `folder`, then io::write_capture (atomic) and
 /// removes the scratch folder. `overwrite` as CaptureWriteOptions.
-SimulatedCapture write_simulated_capture(const CaptureScenario& scenario, const std::filesystem::path& folder, bool overwrite);
+SimulatedCapture write_simulated_capture(const CaptureScenario& scenario, const std::filesystem::path& folder,
+                                         bool overwrite);
 
 /// truth/device.yaml: the IMU model of device_yaml(imu) plus `camera:` (width_px, height_px,
 /// fx_px, fy_px, cx_px, cy_px, distortion [k1, k2, p1, p2, k3]), `camera_imu:` (R_device_camera
@@ -150,7 +183,8 @@ std::string capture_device_yaml(const SimulatedDevice& device, const ImuSimulati
 /// R_world_board rows, p_world_board_m, shots_t_true) unless the scenario has no board, planes
 /// (name, R_world_plane rows, p_world_plane_m, min_xy_m, max_xy_m) and shots (index, image, placement,
 /// t_true, t, R_world_device, p_world_device_m, R_world_camera, p_world_camera_m,
-/// angular_rate_deg_s).
+/// angular_rate_deg_s); antenna captures also setting, mast, antennas and disturbance
+/// (docs/simulator.md).
 std::string capture_scene_yaml(const SimulatedCapture& sim, const camera::BoardSpec& board);
 
 }  // namespace antpose::sim

@@ -30,7 +30,8 @@ struct Profile {
 Profile min_jerk(double tau) {
   tau = std::clamp(tau, 0.0, 1.0);
   const double t2 = tau * tau, t3 = t2 * tau;
-  return {t3 * (10.0 - 15.0 * tau + 6.0 * t2), 30.0 * t2 * (1.0 - 2.0 * tau + t2), 60.0 * tau - 180.0 * t2 + 120.0 * t3};
+  return {t3 * (10.0 - 15.0 * tau + 6.0 * t2), 30.0 * t2 * (1.0 - 2.0 * tau + t2),
+          60.0 * tau - 180.0 * t2 + 120.0 * t3};
 }
 
 // Right Jacobian of SO(3): exp(θ)^T d/dt exp(θ) = [J_r(θ) θ̇]× (Barfoot, State Estimation for
@@ -68,7 +69,8 @@ Mat3 uniform_rotation(std::mt19937_64& rng) {
   const double u1 = u(rng), u2 = u(rng), u3 = u(rng);
   const double a = std::sqrt(1.0 - u1), b = std::sqrt(u1);
   const double two_pi = 2.0 * std::numbers::pi;
-  const Quat q(b * std::cos(two_pi * u3), a * std::sin(two_pi * u2), a * std::cos(two_pi * u2), b * std::sin(two_pi * u3));
+  const Quat q(b * std::cos(two_pi * u3), a * std::sin(two_pi * u2), a * std::cos(two_pi * u2),
+               b * std::sin(two_pi * u3));
   return q.normalized().toRotationMatrix();
 }
 
@@ -84,8 +86,10 @@ Mat3 small_offdiagonal(std::mt19937_64& rng, double sigma) {
 // Sample times k/rate + phase + jitter_k, jitter normal truncated at ±0.45/rate so that the
 // times strictly increase.
 std::vector<double> sample_times(double rate_hz, double jitter_s, double duration, std::mt19937_64& rng) {
-  if (!std::isfinite(rate_hz) || rate_hz <= 0.0) throw std::invalid_argument(fmt::format("sample rate {} Hz must be positive", rate_hz));
-  if (!std::isfinite(jitter_s) || jitter_s < 0.0) throw std::invalid_argument(fmt::format("rate jitter {} s must be >= 0", jitter_s));
+  if (!std::isfinite(rate_hz) || rate_hz <= 0.0)
+    throw std::invalid_argument(fmt::format("sample rate {} Hz must be positive", rate_hz));
+  if (!std::isfinite(jitter_s) || jitter_s < 0.0)
+    throw std::invalid_argument(fmt::format("rate jitter {} s must be >= 0", jitter_s));
   const double period = 1.0 / rate_hz;
   std::uniform_real_distribution<double> phase_dist(0.0, period);
   std::normal_distribution<double> jitter(0.0, jitter_s);
@@ -167,33 +171,38 @@ PhoneModel PhoneModel::typical() {
   PhoneModel p;
   p.name = "typical";
   auto& a = p.accelerometer;
-  a.noise_density = 180.0 * kMicroG;                  // BMI160: 180 µg/√Hz
-  a.bias_random_walk = 4e-4;                          // m/s^3/√Hz, consumer MEMS (bias instability ≈ 0.05 mg)
-  a.bias = Vec3(0.06, -0.09, 0.12);                   // ≈ 6–12 mg residual after factory calibration
-  a.scale = Vec3(1.004, 0.997, 1.002);                // sensitivity tolerance ≈ ±0.5 % after trim
+  a.noise_density = 180.0 * kMicroG;    // BMI160: 180 µg/√Hz
+  a.bias_random_walk = 4e-4;            // m/s^3/√Hz, consumer MEMS (bias instability ≈ 0.05 mg)
+  a.bias = Vec3(0.06, -0.09, 0.12);     // ≈ 6–12 mg residual after factory calibration
+  a.scale = Vec3(1.004, 0.997, 1.002);  // sensitivity tolerance ≈ ±0.5 % after trim
   a.misalignment = Mat3::Identity();
-  a.misalignment(0, 1) = 0.003; a.misalignment(0, 2) = -0.002;   // cross-axis ≈ 0.3 %
-  a.misalignment(1, 0) = -0.001; a.misalignment(1, 2) = 0.002;
-  a.misalignment(2, 0) = 0.002; a.misalignment(2, 1) = -0.003;
+  a.misalignment(0, 1) = 0.003;
+  a.misalignment(0, 2) = -0.002;  // cross-axis ≈ 0.3 %
+  a.misalignment(1, 0) = -0.001;
+  a.misalignment(1, 2) = 0.002;
+  a.misalignment(2, 0) = 0.002;
+  a.misalignment(2, 1) = -0.003;
   a.rate_hz = 100;
   a.rate_jitter_s = 5e-4;
   auto& g = p.gyroscope;
-  g.noise_density = deg2rad(0.007);                   // BMI160: 0.007 °/s/√Hz
-  g.bias_random_walk = 3e-5;                          // rad/s^2/√Hz
-  g.bias = Vec3(deg2rad(0.15), deg2rad(-0.10), deg2rad(0.20));   // residual zero-rate offset
-  g.scale = Vec3(0.996, 1.003, 1.005);                // ±1 % sensitivity tolerance, partly trimmed
+  g.noise_density = deg2rad(0.007);                             // BMI160: 0.007 °/s/√Hz
+  g.bias_random_walk = 3e-5;                                    // rad/s^2/√Hz
+  g.bias = Vec3(deg2rad(0.15), deg2rad(-0.10), deg2rad(0.20));  // residual zero-rate offset
+  g.scale = Vec3(0.996, 1.003, 1.005);                          // ±1 % sensitivity tolerance, partly trimmed
   g.misalignment = Mat3::Identity();
-  g.misalignment(0, 1) = -0.004; g.misalignment(0, 2) = 0.002;
-  g.misalignment(1, 0) = 0.003; g.misalignment(1, 2) = -0.002;
-  g.misalignment(2, 0) = -0.001; g.misalignment(2, 1) = 0.003;
+  g.misalignment(0, 1) = -0.004;
+  g.misalignment(0, 2) = 0.002;
+  g.misalignment(1, 0) = 0.003;
+  g.misalignment(1, 2) = -0.002;
+  g.misalignment(2, 0) = -0.001;
+  g.misalignment(2, 1) = 0.003;
   g.rate_hz = 100;
   g.rate_jitter_s = 5e-4;
   auto& m = p.magnetometer;
-  m.hard_iron_uT = Vec3(1.5, -2.0, 2.5);              // residual after the OS's hard-iron calibration
-  m.soft_iron << 1.01, 0.01, -0.005,                  // ≈ 1 % soft iron from the phone's parts
-                 0.01, 0.99, 0.008,
-                 -0.005, 0.008, 1.02;
-  m.noise_uT = 0.4;                                   // AK09918: ≈ 0.3–0.6 µT rms
+  m.hard_iron_uT = Vec3(1.5, -2.0, 2.5);  // residual after the OS's hard-iron calibration
+  m.soft_iron << 1.01, 0.01, -0.005,      // ≈ 1 % soft iron from the phone's parts
+      0.01, 0.99, 0.008, -0.005, 0.008, 1.02;
+  m.noise_uT = 0.4;  // AK09918: ≈ 0.3–0.6 µT rms
   m.rate_hz = 50;
   m.rate_jitter_s = 1e-3;
   return p;
@@ -205,7 +214,7 @@ PhoneModel PhoneModel::random(std::mt19937_64& rng) {
   p.name = "random";
   std::uniform_real_distribution<double> factor(0.7, 1.3);
   auto& a = p.accelerometer;
-  a.bias = normal3(rng, 0.1);                                  // ≈ 10 mg per axis
+  a.bias = normal3(rng, 0.1);  // ≈ 10 mg per axis
   a.scale = Vec3::Ones() + normal3(rng, 0.004);
   a.misalignment = small_offdiagonal(rng, 0.003);
   a.noise_density = t.accelerometer.noise_density * factor(rng);
@@ -305,7 +314,9 @@ Trajectory& Trajectory::with_tremor(double rotation_rms_rad, double translation_
   return *this;
 }
 
-double Trajectory::duration() const { return segments_.empty() ? 0.0 : segments_.back().t0 + segments_.back().duration; }
+double Trajectory::duration() const {
+  return segments_.empty() ? 0.0 : segments_.back().t0 + segments_.back().duration;
+}
 
 Mat3 Trajectory::end_R_world_device() const {
   if (segments_.empty()) return R_start_;
@@ -321,7 +332,8 @@ Vec3 Trajectory::end_position_world() const {
 
 const Trajectory::Segment& Trajectory::segment_at(double t) const {
   if (segments_.empty()) throw std::invalid_argument("Trajectory: no segments (add hold/rotate_to first)");
-  auto it = std::upper_bound(segments_.begin(), segments_.end(), t, [](double v, const Segment& s) { return v < s.t0; });
+  auto it =
+      std::upper_bound(segments_.begin(), segments_.end(), t, [](double v, const Segment& s) { return v < s.t0; });
   return it == segments_.begin() ? segments_.front() : *std::prev(it);
 }
 
@@ -333,9 +345,15 @@ Vec3 sum_sin(const Sinusoids& list, double t, int derivative) {
     for (int i = 0; i < 3; ++i) {
       const double arg = s.omega * t + s.phase[i];
       switch (derivative) {
-        case 0: out[i] += s.amplitude[i] * std::sin(arg); break;
-        case 1: out[i] += s.amplitude[i] * s.omega * std::cos(arg); break;
-        default: out[i] -= s.amplitude[i] * s.omega * s.omega * std::sin(arg); break;
+        case 0:
+          out[i] += s.amplitude[i] * std::sin(arg);
+          break;
+        case 1:
+          out[i] += s.amplitude[i] * s.omega * std::cos(arg);
+          break;
+        default:
+          out[i] -= s.amplitude[i] * s.omega * s.omega * std::sin(arg);
+          break;
       }
     }
   return out;
@@ -413,7 +431,8 @@ std::vector<Mat3> calibration_poses() {
   auto pose = [](const Vec3& up_device, const Vec3& north_device) {
     Mat3 R_device_world;
     R_device_world.col(2) = up_device.normalized();
-    R_device_world.col(1) = (north_device - north_device.dot(R_device_world.col(2)) * R_device_world.col(2)).normalized();
+    R_device_world.col(1) =
+        (north_device - north_device.dot(R_device_world.col(2)) * R_device_world.col(2)).normalized();
     R_device_world.col(0) = R_device_world.col(1).cross(R_device_world.col(2));
     return Mat3(R_device_world.transpose());
   };
@@ -445,7 +464,8 @@ Trajectory tumble(double duration_s, double move_s, std::uint64_t seed) {
   auto rng = make_rng(seed, 0x70);
   Trajectory tr;
   tr.hold(uniform_rotation(rng), 1.0);
-  while (tr.duration() + move_s + 1.0 <= duration_s || tr.duration() <= 1.0) tr.rotate_to(uniform_rotation(rng), move_s);
+  while (tr.duration() + move_s + 1.0 <= duration_s || tr.duration() <= 1.0)
+    tr.rotate_to(uniform_rotation(rng), move_s);
   tr.hold(1.0);
   return tr;
 }
@@ -481,7 +501,8 @@ Capture simulate_imu(const ImuSimulation& sim) {
   if (tr.empty()) throw std::invalid_argument("simulate_imu: the trajectory is empty");
   if (!std::isfinite(sim.truth_rate_hz) || sim.truth_rate_hz <= 0.0)
     throw std::invalid_argument(fmt::format("simulate_imu: truth rate {} Hz must be positive", sim.truth_rate_hz));
-  if (sim.earth_rotation && !sim.site) throw std::invalid_argument("simulate_imu: earth_rotation needs a site (latitude)");
+  if (sim.earth_rotation && !sim.site)
+    throw std::invalid_argument("simulate_imu: earth_rotation needs a site (latitude)");
   const double T = tr.duration();
   const Vec3 g_world(0.0, 0.0, -sim.gravity);
   const Vec3 earth_world = sim.earth_rotation ? earth_rate_enu(sim.site->lat_deg) : Vec3::Zero();
@@ -496,10 +517,11 @@ Capture simulate_imu(const ImuSimulation& sim) {
   c.truth_world = sim.truth_world;
 
   auto rng_acc = make_rng(sim.seed, 1), rng_gyr = make_rng(sim.seed, 2), rng_mag = make_rng(sim.seed, 3);
-  c.streams.emplace(std::string(streams::kAccelerometer),
-                    inertial_stream(std::string(streams::kAccelerometer), sim.phone.accelerometer, T, rng_acc, [&](double t) {
-                      return Vec3(tr.R_world_device(t).transpose() * (tr.acceleration_world(t) - g_world));
-                    }));
+  c.streams.emplace(
+      std::string(streams::kAccelerometer),
+      inertial_stream(std::string(streams::kAccelerometer), sim.phone.accelerometer, T, rng_acc, [&](double t) {
+        return Vec3(tr.R_world_device(t).transpose() * (tr.acceleration_world(t) - g_world));
+      }));
   c.streams.emplace(std::string(streams::kGyroscope),
                     inertial_stream(std::string(streams::kGyroscope), sim.phone.gyroscope, T, rng_gyr, [&](double t) {
                       Vec3 w = tr.angular_velocity_device(t);
@@ -514,6 +536,10 @@ Capture simulate_imu(const ImuSimulation& sim) {
       Vec3 B = sim.field_world_uT;
       for (const auto& d : sim.disturbances)
         if (t[k] >= d.t0 && t[k] < d.t1) B += d.extra_world_uT;
+      if (!sim.dipoles.empty()) {
+        const Vec3 p = tr.position_world(t[k]);
+        for (const auto& d : sim.dipoles) B += dipole_field_uT(d, p);
+      }
       y[k] = m.apply(tr.R_world_device(t[k]).transpose() * B);
       if (m.noise_uT > 0.0) y[k] += normal3(rng_mag, m.noise_uT);
     }
@@ -570,6 +596,17 @@ std::string device_yaml(const ImuSimulation& sim) {
     dist.push_back(n);
   }
   root["disturbances"] = dist;
+  if (!sim.dipoles.empty()) {
+    YAML::Node dip(YAML::NodeType::Sequence);
+    for (const auto& d : sim.dipoles) {
+      YAML::Node n;
+      n["p_world_m"] = yaml_flow_vector(d.p_world);
+      n["moment_Am2"] = yaml_flow_vector(d.moment_Am2);
+      dip.push_back(n);
+    }
+    root["dipoles"] = dip;
+    root["dipoles_model"] = "B += 1e-7 (3 r^ (r^.m) - m) / |r|^3 T at the device position, r = p_device - p_dipole";
+  }
   return emit(root);
 }
 
@@ -609,6 +646,14 @@ Capture simulate_contact(ImuSimulation sim, const Mat3& R_world_antenna, Contact
   c.generated_files["truth/scene.yaml"] = contact_scene_yaml(truth);
   c.metadata["truth"]["scene"] = "truth/scene.yaml";
   return c;
+}
+
+Vec3 dipole_field_uT(const MagneticDipole& dipole, const Vec3& p_world) {
+  const Vec3 r = p_world - dipole.p_world;
+  const double d = std::max(r.norm(), 0.05);
+  const Vec3 u = r.norm() > 0.0 ? Vec3(r / r.norm()) : Vec3::UnitZ();
+  // 1e-7 T·m/A = 0.1 µT·m/A.
+  return 0.1 * (3.0 * u * u.dot(dipole.moment_Am2) - dipole.moment_Am2) / (d * d * d);
 }
 
 double normal_gravity(double lat_deg, double alt_m) {

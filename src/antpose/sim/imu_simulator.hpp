@@ -8,7 +8,8 @@
 //     K  diagonal scale factors, b constant (residual) bias,
 //     b_w bias random walk (rate random walk), n white noise (angle/velocity random walk).
 //   magnetometer:  m = S (R_world_device^T (B_world + d(t))) + h + n
-//     S soft iron, h hard iron (µT), d(t) local disturbances, n white noise (µT rms per sample).
+//     S soft iron, h hard iron (µT), d(t) local disturbances (time windows, plus the field of
+//     magnetic dipoles evaluated at the device's position), n white noise (µT rms per sample).
 // Noise densities follow IEEE Std 952-1997 (Allan-variance coefficients N and K): sampled at
 // rate f (Nyquist bandwidth f/2), white noise has std = N·sqrt(f); the bias random walk
 // advances by K·sqrt(Δt)·N(0,1) per sample.
@@ -84,6 +85,16 @@ struct MagneticDisturbance {
   double t1 = 0;
   Vec3 extra_world_uT = Vec3::Zero();
 };
+
+/// A point magnetic dipole (a magnetised steel part: a mast is a line of them), world frame.
+struct MagneticDipole {
+  Vec3 p_world = Vec3::Zero();     // m
+  Vec3 moment_Am2 = Vec3::Zero();  // A·m²
+};
+
+/// Field of a dipole at p_world, µT: μ0/(4π) (3 r̂ (r̂·m) − m) / |r|³ with r = p_world − p_dipole
+/// (μ0/(4π) = 1e-7 T·m/A); |r| is floored at 5 cm (the field inside steel is not a dipole's).
+Vec3 dipole_field_uT(const MagneticDipole& dipole, const Vec3& p_world);
 
 /// A trajectory of the device: R_world_device(t) and position p_world(t), built from segments
 /// (holds and smooth minimum-jerk moves) with an optional hand tremor on top. Time runs from 0
@@ -164,11 +175,11 @@ Trajectory tumble(double duration_s, double move_s, std::uint64_t seed);
 /// Motion of the contact measurement: the phone is brought from the hand onto the antenna's
 /// back plate, held there, then taken away.
 struct ContactMotion {
-  double before_s = 1.0;     // still in the hand before the approach
-  double approach_s = 2.5;   // hand → plate
-  double hold_s = 8.0;       // lying on the plate
-  double removal_s = 2.0;    // plate → hand
-  double after_s = 1.0;      // still in the hand at the end
+  double before_s = 1.0;    // still in the hand before the approach
+  double approach_s = 2.5;  // hand → plate
+  double hold_s = 8.0;      // lying on the plate
+  double removal_s = 2.0;   // plate → hand
+  double after_s = 1.0;     // still in the hand at the end
   double tremor_rotation_rms_rad = 0.001;
   double tremor_translation_rms_m = 1e-5;
 };
@@ -184,8 +195,9 @@ struct ImuSimulation {
   PhoneModel phone = PhoneModel::ideal();
   Vec3 field_world_uT = Vec3(0.0, 24.0, -41.569219381653056);  // ENU, µT (48 µT, dip 60°, no declination)
   std::vector<MagneticDisturbance> disturbances;
-  double gravity = 9.80665;     // m/s^2 (see normal_gravity for a site)
-  bool earth_rotation = false;  // add Earth's rate (needs `site` for the latitude)
+  std::vector<MagneticDipole> dipoles;  // position-dependent disturbance at the device's position
+  double gravity = 9.80665;             // m/s^2 (see normal_gravity for a site)
+  bool earth_rotation = false;          // add Earth's rate (needs `site` for the latitude)
   std::optional<Site> site;
   std::optional<std::string> time_origin;  // ISO-8601 UTC of t = 0
   std::string kind = "imu-log";
@@ -211,7 +223,7 @@ std::string device_yaml(const ImuSimulation& sim);
 struct ContactTruth {
   Mat3 R_world_antenna = Mat3::Identity();
   ContactPlacement placement = ContactPlacement::kTopUp;
-  double declination = 0;  // rad, east positive, from the simulated field
+  double declination = 0;                // rad, east positive, from the simulated field
   std::pair<double, double> hold{0, 0};  // when the phone lies on the plate, s
 };
 /// truth/scene.yaml text: antennas[0] with R_world_antenna, azimuth_deg (true),

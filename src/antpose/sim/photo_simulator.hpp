@@ -1,11 +1,24 @@
 // Photo simulator: renders what a phone camera sees of a scene made of planar textured patches
-// (calibration boards, ground, walls), then applies the optics and the sensor.
+// (calibration boards, ground, walls) and triangle meshes (masts, antennas, brackets), then
+// applies the optics and the sensor.
 //
 // Geometry (frames per docs/conventions.md): the camera is OpenCV's pinhole with the 5-coefficient
 // distortion of camera::CameraIntrinsics. A pixel (u, v) (OpenCV: integer coordinates at pixel
 // centres) sees along the ray R_world_camera · (x, y, 1), where (x, y) = undistort((u − cx)/fx,
 // (v − cy)/fy), i.e. exactly the inverse of CameraIntrinsics::project. Every ray is intersected
-// with every patch; the nearest hit in front of the camera wins (a per-sample z-buffer).
+// with every patch and with the triangles that may cover its pixel; the nearest hit in front of
+// the camera wins (one z-buffer per sample for patches and meshes together).
+//
+// Meshes: the rays are fixed per renderer but distorted, so triangles are not rasterised in
+// pixel space (their edges curve there); instead they are binned per photo into 16 × 16-pixel
+// tiles by their bounding box in undistorted normalised coordinates (where a triangle stays a
+// triangle), against each tile's precomputed normalised bounding box. A sample then tests only
+// its tile's triangles, with three edge functions d·(v_i × v_j) of the ray d = (x, y, 1) from
+// the camera centre, which also give its exact perspective barycentrics and depth. This beats a
+// BVH here: the binning costs O(triangles × tiles they cover) once per photo, the inner loop is
+// four dot products per triangle, and rays that miss every mesh (most of an outdoor photo) cost
+// one tile lookup. Shared edges use the same (negated) edge vectors, so meshes are watertight.
+// Smooth shading interpolates per-corner normals (smooth_corner_normals) with the barycentrics.
 //
 // Anti-aliasing (so that rendered boards give sub-pixel-accurate corners): each pixel averages
 // S × S ray samples on a regular sub-pixel grid (a box filter over the pixel), and each sample
@@ -21,7 +34,9 @@
 // Gaussian of variance = electrons) and read noise, gamma 1/2.2, 8-bit; then JPEG.
 #pragma once
 
+#include <array>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -31,6 +46,7 @@
 
 #include "antpose/camera/camera_model.hpp"
 #include "antpose/geometry/rotation.hpp"
+#include "antpose/model/mesh.hpp"
 
 namespace antpose::sim {
 
@@ -47,8 +63,8 @@ struct Texture {
   /// level is an exact 2 × 2 box average of the one below. std::invalid_argument for an empty
   /// image, a repeating texture whose size is not a multiple of 2^(levels − 1), or a
   /// non-invertible texel_from_patch.
-  static Texture from_image(const cv::Mat& reflectance, const Eigen::Matrix<double, 2, 3>& texel_from_patch, bool repeat,
-                            int max_levels = 8);
+  static Texture from_image(const cv::Mat& reflectance, const Eigen::Matrix<double, 2, 3>& texel_from_patch,
+                            bool repeat, int max_levels = 8);
 };
 
 /// A planar rectangle in the world with a texture. The patch frame: x, y in the plane, z = x × y
@@ -60,6 +76,37 @@ struct TexturedPatch {
   Eigen::Vector2d min_xy = Eigen::Vector2d::Zero(), max_xy = Eigen::Vector2d::Zero();
   std::shared_ptr<const Texture> texture;
   double albedo = 1.0;  // multiplies the texture's reflectance
+};
+
+/// A triangle mesh in the world: vertices in the object frame, placed by R_world_object,
+/// p_world_object. Lambert-shaded with the interpolated corner normals (flat when empty),
+/// radiance = albedo · reflectance(p_object) · (ambient + direct · max(0, n·l)).
+struct MeshObject {
+  std::string name;
+  model::Mesh mesh;                                 // object frame, m
+  std::vector<std::array<Vec3, 3>> corner_normals;  // object frame, one per triangle corner
+  Mat3 R_world_object = Mat3::Identity();
+  Vec3 p_world_object = Vec3::Zero();
+  double albedo = 0.5;
+  /// Optional reflectance multiplier at an object-frame surface point (weathering, labels);
+  /// must be thread-safe (called concurrently).
+  std::function<double(const Vec3& p_object)> reflectance;
+  /// A closed, outward-wound mesh: faces turned away from the camera are skipped (never
+  /// visible). Otherwise both sides are drawn, shaded on the side facing the camera.
+  bool cull_back_faces = true;
+};
+
+/// Per-corner normals of a mesh, smoothed across edges whose dihedral angle is below
+/// `crease_rad` (face normals of the triangles around each vertex weighted by their corner
+/// angles; vertices at the same position are welded first), so rounded panel edges shade smoothly while box edges
+/// stay sharp. Normals follow the winding (model/mesh.hpp).
+std::vector<std::array<Vec3, 3>> smooth_corner_normals(const model::Mesh& mesh, double crease_rad);
+
+/// What a photo shows: planar patches and meshes. Object ids (PhotoRenderer::render) number the
+/// patches 0..P−1, then the meshes P..P+M−1.
+struct Scene {
+  std::vector<TexturedPatch> patches;
+  std::vector<MeshObject> meshes;
 };
 
 /// A distant light and an ambient term (see the file comment).
@@ -80,7 +127,7 @@ struct CameraPose {
 /// Pixel of a world point seen from `pose` (CameraIntrinsics::project in the camera frame);
 /// std::nullopt behind the camera.
 std::optional<Vec2> project_world(const camera::CameraIntrinsics& intrinsics, const CameraPose& pose,
-                                          const Vec3& p_world);
+                                  const Vec3& p_world);
 
 /// Renders linear radiance images of a camera. Construction undistorts every pixel centre once
 /// (the ray grid and its Jacobian d(x, y)/d(u, v)), so one renderer serves many photos.
@@ -92,6 +139,11 @@ class PhotoRenderer {
   /// CV_32FC1 radiance (height × width), 1.0 = a white surface fully lit with ambient + direct = 1.
   /// Parallel over rows (cv::parallel_for_).
   cv::Mat render(const std::vector<TexturedPatch>& patches, const CameraPose& pose, const Lighting& lighting) const;
+  /// The same for patches and meshes; `object_ids` (optional) receives CV_32SC1 the object id
+  /// (Scene) hit by each pixel's central sample, −1 for the sky. std::invalid_argument for a
+  /// patch without a texture or a mesh triangle indexing outside its vertices.
+  cv::Mat render(const Scene& scene, const CameraPose& pose, const Lighting& lighting,
+                 cv::Mat* object_ids = nullptr) const;
 
   const camera::CameraIntrinsics& intrinsics() const { return intrinsics_; }
   int supersampling() const { return supersampling_; }
@@ -99,20 +151,23 @@ class PhotoRenderer {
  private:
   camera::CameraIntrinsics intrinsics_;
   int supersampling_;
-  cv::Mat xy_;        // CV_32FC2: undistorted normalised (x, y) of each pixel centre
-  cv::Mat jacobian_;  // CV_32FC4: (dx/du, dx/dv, dy/du, dy/dv)
+  cv::Mat xy_;                      // CV_32FC2: undistorted normalised (x, y) of each pixel centre
+  cv::Mat jacobian_;                // CV_32FC4: (dx/du, dx/dv, dy/du, dy/dv)
+  static constexpr int kTile = 16;  // px, side of the mesh binning tiles
+  int tiles_x_ = 0, tiles_y_ = 0;
+  std::vector<std::array<float, 4>> tile_box_;  // per tile: normalised x0, x1, y0, y1 of its samples
 };
 
 /// Optics and sensor of the simulated phone camera.
 struct SensorModel {
-  double exposure_s = 0.002;      // motion blur length = image flow × exposure
-  double blur_sigma_px = 0.6;     // Gaussian defocus / lens PSF, px (0: none)
-  double gain = 0.85;             // fraction of the full well reached by radiance 1.0
-  double full_well_e = 6000.0;    // electrons (a 1.4 µm phone pixel)
-  double read_noise_e = 3.0;      // electrons rms
-  double noise_scale = 1.0;       // multiplies photon and read noise; 0: noise-free
-  double gamma = 2.2;             // output encoding: value = linear^(1/gamma)
-  int jpeg_quality = 92;          // 1..100
+  double exposure_s = 0.002;    // motion blur length = image flow × exposure
+  double blur_sigma_px = 0.6;   // Gaussian defocus / lens PSF, px (0: none)
+  double gain = 0.85;           // fraction of the full well reached by radiance 1.0
+  double full_well_e = 6000.0;  // electrons (a 1.4 µm phone pixel)
+  double read_noise_e = 3.0;    // electrons rms
+  double noise_scale = 1.0;     // multiplies photon and read noise; 0: noise-free
+  double gamma = 2.2;           // output encoding: value = linear^(1/gamma)
+  int jpeg_quality = 92;        // 1..100
 };
 
 /// Blurs a radiance image along the image motion of a rotation at `omega_camera` (rad/s, camera

@@ -1,0 +1,321 @@
+#include "antpose/sim/antenna_scene.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+#include "antpose/core/error.hpp"
+#include "antpose/sim/board_texture.hpp"
+
+namespace antpose::sim {
+
+namespace {
+
+double uniform(std::mt19937_64& rng, double lo, double hi) {
+  return std::uniform_real_distribution<double>(lo, hi)(rng);
+}
+
+// --- procedural noise (value noise on an integer lattice, hashed: no tables, thread-safe) ---
+
+std::uint64_t mix(std::uint64_t x) {
+  // splitmix64 finaliser
+  x += 0x9e3779b97f4a7c15ULL;
+  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
+  return x ^ (x >> 31);
+}
+
+double lattice(std::int64_t i, std::int64_t j, std::int64_t k, std::uint64_t seed) {
+  const std::uint64_t h = mix(seed ^ mix(static_cast<std::uint64_t>(i) ^
+                                         mix(static_cast<std::uint64_t>(j) ^ mix(static_cast<std::uint64_t>(k)))));
+  return static_cast<double>(h >> 11) * (2.0 / 9007199254740992.0) - 1.0;  // [-1, 1)
+}
+
+// Smooth value noise in [-1, 1] with unit lattice spacing.
+double value_noise(const Vec3& p, std::uint64_t seed) {
+  const double fx = std::floor(p.x()), fy = std::floor(p.y()), fz = std::floor(p.z());
+  const auto i = static_cast<std::int64_t>(fx), j = static_cast<std::int64_t>(fy), k = static_cast<std::int64_t>(fz);
+  auto smooth = [](double t) { return t * t * (3.0 - 2.0 * t); };
+  const double ax = smooth(p.x() - fx), ay = smooth(p.y() - fy), az = smooth(p.z() - fz);
+  double c[2][2][2];
+  for (int a = 0; a < 2; ++a)
+    for (int b = 0; b < 2; ++b)
+      for (int d = 0; d < 2; ++d) c[a][b][d] = lattice(i + a, j + b, k + d, seed);
+  auto lerp = [](double u, double v, double t) { return u + t * (v - u); };
+  const double x00 = lerp(c[0][0][0], c[1][0][0], ax), x10 = lerp(c[0][1][0], c[1][1][0], ax);
+  const double x01 = lerp(c[0][0][1], c[1][0][1], ax), x11 = lerp(c[0][1][1], c[1][1][1], ax);
+  return lerp(lerp(x00, x10, ay), lerp(x01, x11, ay), az);
+}
+
+Mat3 rot_antenna(double azimuth, double downtilt, double roll) {
+  return rot_z(-azimuth) * rot_x(-downtilt) * rot_y(roll);
+}
+
+constexpr double kRadomeAlbedo = 0.72, kSteelAlbedo = 0.42;
+
+}  // namespace
+
+std::string to_string(AntennaSetting s) { return s == AntennaSetting::kRooftop ? "rooftop" : "ground"; }
+std::string to_string(RadomeLook l) { return l == RadomeLook::kPlain ? "plain" : "weathered"; }
+
+AntennaSetting parse_antenna_setting(const std::string& name) {
+  if (name == "rooftop") return AntennaSetting::kRooftop;
+  if (name == "ground") return AntennaSetting::kGround;
+  throw InputError("--setting", fmt::format("'{}' is not rooftop or ground", name));
+}
+
+RadomeLook parse_radome_look(const std::string& name) {
+  if (name == "plain") return RadomeLook::kPlain;
+  if (name == "weathered") return RadomeLook::kWeathered;
+  throw InputError("--radome", fmt::format("'{}' is not plain or weathered", name));
+}
+
+model::Mesh box_mesh(const Vec3& h) {
+  model::Mesh m;
+  for (int i = 0; i < 8; ++i)
+    m.vertices.emplace_back((i & 1 ? 1 : -1) * h.x(), (i & 2 ? 1 : -1) * h.y(), (i & 4 ? 1 : -1) * h.z());
+  // Faces counter-clockwise seen from outside.
+  const std::array<std::array<std::uint32_t, 4>, 6> faces{
+      {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}}};
+  for (const auto& f : faces) {
+    m.triangles.push_back({f[0], f[1], f[2]});
+    m.triangles.push_back({f[0], f[2], f[3]});
+  }
+  return m;
+}
+
+model::Mesh cylinder_mesh(const Vec3& a, const Vec3& b, double radius, int segments) {
+  if (segments < 3 || !(radius > 0.0) || !((b - a).norm() > 0.0))
+    throw std::invalid_argument("cylinder_mesh: bad size");
+  const Vec3 axis = (b - a).normalized();
+  const Vec3 u = (std::abs(axis.z()) < 0.9 ? axis.cross(Vec3::UnitZ()) : axis.cross(Vec3::UnitX())).normalized();
+  const Vec3 v = axis.cross(u);
+  model::Mesh m;
+  const auto n = static_cast<std::uint32_t>(segments);
+  for (std::uint32_t i = 0; i < n; ++i) {
+    const double t = 2.0 * std::numbers::pi * i / n;
+    const Vec3 r = radius * (std::cos(t) * u + std::sin(t) * v);
+    m.vertices.push_back(a + r);
+    m.vertices.push_back(b + r);
+  }
+  const auto ca = static_cast<std::uint32_t>(m.vertices.size());
+  m.vertices.push_back(a);
+  m.vertices.push_back(b);
+  for (std::uint32_t i = 0; i < n; ++i) {
+    const std::uint32_t j = (i + 1) % n;
+    // (u, v, axis) is right-handed: counter-clockwise about the axis is the outward winding.
+    m.triangles.push_back({2 * i, 2 * j, 2 * j + 1});
+    m.triangles.push_back({2 * i, 2 * j + 1, 2 * i + 1});
+    m.triangles.push_back({ca, 2 * j, 2 * i});
+    m.triangles.push_back({ca + 1, 2 * i + 1, 2 * j + 1});
+  }
+  return m;
+}
+
+AntennaLayout draw_antenna_layout(AntennaSetting setting, int antennas, std::mt19937_64& rng) {
+  if (antennas < 1 || antennas > 3) throw InputError("--antennas", fmt::format("{} is outside 1..3", antennas));
+  AntennaLayout L;
+  L.setting = setting;
+  const bool roof = setting == AntennaSetting::kRooftop;
+  L.mast_radius_m = roof ? 0.057 : 0.25;  // a 114 mm pipe; a 0.5 m monopole
+  L.building_height_m = roof ? uniform(rng, 15.0, 30.0) : 0.0;
+  const double z_centre = roof ? uniform(rng, 2.0, 3.2) : uniform(rng, 10.0, 20.0);
+  const double az0 = uniform(rng, 0.0, 2.0 * std::numbers::pi);
+  const auto names = model::builtin_panel_names();
+  double top = 0.0;
+  for (int k = 0; k < antennas; ++k) {
+    SimAntenna a;
+    a.name = fmt::format("antenna-{}", k + 1);
+    a.model_name =
+        names[static_cast<std::size_t>(std::uniform_int_distribution<int>(0, static_cast<int>(names.size()) - 1)(rng))];
+    const model::AntennaModel m = model::builtin_panel(a.model_name);
+    a.spec.width_m = m.size_m.x(), a.spec.depth_m = m.size_m.y(), a.spec.height_m = m.size_m.z();
+    const double jitter = k == 0 ? 0.0 : deg2rad(uniform(rng, -10.0, 10.0));
+    a.azimuth_magnetic =
+        std::fmod(az0 + k * 2.0 * std::numbers::pi / 3.0 + jitter + 2.0 * std::numbers::pi, 2.0 * std::numbers::pi);
+    a.downtilt = deg2rad(uniform(rng, 0.0, 12.0));
+    a.roll = deg2rad(uniform(rng, -2.0, 2.0));
+    a.R_world_antenna = rot_antenna(a.azimuth_magnetic, a.downtilt, a.roll);
+    // Out from the mast along the horizontal boresight, so that the nearer bracket's arm is at
+    // least 12 cm long beyond the pole's surface.
+    const Vec3 b_h(std::sin(a.azimuth_magnetic), std::cos(a.azimuth_magnetic), 0.0);
+    double s_min = 0.0;
+    for (const double k_z : {-0.25, 0.25}) {
+      const Vec3 q = a.R_world_antenna * Vec3(0.0, -a.spec.depth_m / 2 - a.spec.bracket_depth_m, k_z * a.spec.height_m);
+      s_min = std::min(s_min, q.dot(b_h));
+    }
+    const double r_c = L.mast_radius_m + 0.12 - s_min;
+    a.p_world_antenna = r_c * b_h + Vec3(0.0, 0.0, z_centre + uniform(rng, -0.05, 0.05));
+    top = std::max(top, a.p_world_antenna.z() + a.spec.height_m / 2);
+    L.antennas.push_back(a);
+  }
+  L.mast_top_m = top + (roof ? 0.3 : 1.0);
+  return L;
+}
+
+std::function<double(const Vec3&)> weathering_reflectance(const model::PanelSpec& s, std::uint64_t seed) {
+  // The label: lines of "text" (dark bars of random lengths) on white, near the bottom of the
+  // radome's flat front.
+  const double half_w = std::min(0.06, (s.width_m / 2 - s.edge_radius_m) - 0.005);
+  const double z0 = -s.height_m / 2 + 0.10, z1 = z0 + 0.08;
+  std::mt19937_64 rng(mix(seed ^ 0x1abe1ULL));
+  std::vector<std::array<double, 4>> bars;  // x0, x1, z0, z1 in the antenna frame
+  for (int line = 0; line < 4; ++line) {
+    const double zb = z1 - 0.012 - line * 0.017, zt = zb + (line == 0 ? 0.010 : 0.007);
+    double x = -half_w + 0.008;
+    while (x < half_w - 0.012) {
+      const double len = uniform(rng, 0.004, line == 0 ? 0.03 : 0.015);
+      const double x_end = std::min(x + len, half_w - 0.008);
+      bars.push_back({x, x_end, zb, zt});
+      x = x_end + uniform(rng, 0.002, 0.006);
+    }
+  }
+  const double front = s.depth_m / 2 - 1e-4, back = -s.depth_m / 2 - 1e-4, cap = s.height_m / 2 - 1e-4;
+  const std::uint64_t s1 = mix(seed + 1), s2 = mix(seed + 2), s3 = mix(seed + 3);
+  return [=](const Vec3& p) {
+    if (p.y() < back) return 0.5;           // bracket: galvanised steel
+    if (std::abs(p.z()) > cap) return 0.8;  // end caps: a darker grey plastic
+    if (p.y() > front && std::abs(p.x()) <= half_w && p.z() >= z0 && p.z() <= z1) {
+      for (const auto& b : bars)
+        if (p.x() >= b[0] && p.x() <= b[1] && p.z() >= b[2] && p.z() <= b[3]) return 0.2;
+      return 1.25;  // label paper
+    }
+    // Dirt: ±3 % over 1–10 cm; streaks: stretched 30× along the panel; grime towards the bottom.
+    const double dirt =
+        0.6 * value_noise(p / 0.08, s1) + 0.3 * value_noise(p / 0.025, s2) + 0.1 * value_noise(p / 0.01, s2 + 7);
+    const double streak = value_noise(Vec3(p.x() / 0.012, p.y() / 0.012, p.z() / 0.4), s3);
+    const double grime = std::exp(-(p.z() + s.height_m / 2) / 0.15);
+    return std::clamp(1.0 + 0.03 * dirt - 0.025 * std::max(0.0, streak) - 0.05 * grime, 0.5, 1.2);
+  };
+}
+
+std::vector<MeshObject> antenna_meshes(const AntennaLayout& L, RadomeLook look, std::uint64_t seed) {
+  std::vector<MeshObject> out;
+  const double crease = deg2rad(40.0);
+  MeshObject mast;
+  mast.name = "mast";
+  mast.mesh = cylinder_mesh(Vec3::Zero(), Vec3(0.0, 0.0, L.mast_top_m), L.mast_radius_m, 24);
+  mast.corner_normals = smooth_corner_normals(mast.mesh, crease);
+  mast.albedo = kSteelAlbedo;
+  out.push_back(mast);
+  for (std::size_t k = 0; k < L.antennas.size(); ++k) {
+    const SimAntenna& a = L.antennas[k];
+    MeshObject panel;
+    panel.name = a.name;
+    panel.mesh = model::builtin_panel(a.model_name).mesh_antenna;
+    panel.corner_normals = smooth_corner_normals(panel.mesh, crease);
+    panel.R_world_object = a.R_world_antenna;
+    panel.p_world_object = a.p_world_antenna;
+    panel.albedo = kRadomeAlbedo;
+    if (look == RadomeLook::kWeathered) {
+      panel.reflectance = weathering_reflectance(a.spec, seed * 31 + k);
+    } else {
+      const double back = -a.spec.depth_m / 2 - 1e-4;
+      panel.reflectance = [back](const Vec3& p) { return p.y() < back ? 0.5 : 1.0; };  // uniform radome
+    }
+    out.push_back(panel);
+    // Arms from the mast axis to each bracket's back face, and a clamp around the pole.
+    for (const double kz : {-0.25, 0.25}) {
+      const Vec3 q = a.p_world_antenna +
+                     a.R_world_antenna * Vec3(0.0, -a.spec.depth_m / 2 - a.spec.bracket_depth_m, kz * a.spec.height_m);
+      const Vec3 axis_point(0.0, 0.0, q.z());
+      const Vec3 along = q - axis_point;
+      const double len = along.norm();
+      Mat3 R;
+      R.col(0) = along / len;
+      R.col(2) = Vec3::UnitZ();
+      R.col(1) = R.col(2).cross(R.col(0));
+      MeshObject arm;
+      arm.name = fmt::format("{}-arm-{}", a.name, kz < 0 ? "low" : "high");
+      arm.mesh = box_mesh(Vec3(len / 2, 0.025, 0.025));
+      arm.R_world_object = R;
+      arm.p_world_object = axis_point + along / 2;
+      arm.albedo = kSteelAlbedo * 0.9;
+      out.push_back(arm);
+      MeshObject clamp;
+      clamp.name = fmt::format("{}-clamp-{}", a.name, kz < 0 ? "low" : "high");
+      const double c = L.mast_radius_m + 0.015;
+      clamp.mesh = box_mesh(Vec3(c, c, 0.05));
+      clamp.R_world_object = R;
+      clamp.p_world_object = axis_point;
+      clamp.albedo = kSteelAlbedo * 0.8;
+      out.push_back(clamp);
+    }
+  }
+  return out;
+}
+
+std::vector<TexturedPatch> antenna_site_patches(const AntennaLayout& L, double half_size_m, std::uint64_t seed) {
+  std::vector<TexturedPatch> out;
+  auto ground = [&](const std::string& name, double z, double half, std::shared_ptr<const Texture> tex) {
+    TexturedPatch g;
+    g.name = name;
+    g.p_world_patch = Vec3(0.0, 0.0, z);
+    g.min_xy = Eigen::Vector2d(-half, -half);
+    g.max_xy = Eigen::Vector2d(half, half);
+    g.texture = std::move(tex);
+    return g;
+  };
+  if (L.setting == AntennaSetting::kRooftop) {
+    // Roof membrane and parapets (the room of room_patches, 1.1 m walls), the street below.
+    out = room_patches(seed, half_size_m, 1.1);
+    out[0].name = "roof";
+    out[0].texture = procedural_texture(seed * 7 + 11, 3.0, 1024, 0.42, 0.08);
+    for (std::size_t i = 1; i < out.size(); ++i)
+      out[i].name = "parapet" + out[i].name.substr(4);  // "wall-north" → "parapet-north"
+    out.push_back(
+        ground("street", -L.building_height_m, 150.0, procedural_texture(seed * 7 + 12, 4.0, 1024, 0.25, 0.08)));
+  } else {
+    out.push_back(ground("ground", 0.0, 150.0, procedural_texture(seed * 7 + 13, 2.0, 1024, 0.32, 0.09)));
+  }
+  return out;
+}
+
+double north_shift(const std::vector<MagneticDipole>& dipoles, const Vec3& field_world_uT, const Vec3& p_world) {
+  Vec3 B = field_world_uT;
+  for (const auto& d : dipoles) B += dipole_field_uT(d, p_world);
+  return std::atan2(B.x(), B.y()) - std::atan2(field_world_uT.x(), field_world_uT.y());
+}
+
+std::vector<MagneticDipole> mast_dipoles(const AntennaLayout& L, const Vec3& field_world_uT, const Vec3& p_reference,
+                                         double shift, std::mt19937_64& rng) {
+  constexpr int kCount = 12;
+  const Eigen::Vector2d h0(field_world_uT.x(), field_world_uT.y());
+  // Magnetic north turned clockwise by `shift`.
+  const Eigen::Vector2d u(std::cos(shift) * h0.x() + std::sin(shift) * h0.y(),
+                          -std::sin(shift) * h0.x() + std::cos(shift) * h0.y());
+  auto cross2 = [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); };
+  std::vector<MagneticDipole> best;
+  double best_scale = std::numeric_limits<double>::infinity();
+  for (int attempt = 0; attempt < 32; ++attempt) {
+    // Induced (along the Earth field) plus a horizontal remanent part of random direction.
+    const double psi = uniform(rng, 0.0, 2.0 * std::numbers::pi), remanent = uniform(rng, 0.3, 1.0);
+    const Vec3 dir = (field_world_uT.normalized() + remanent * Vec3(std::cos(psi), std::sin(psi), 0.0)).normalized();
+    std::vector<MagneticDipole> unit(kCount);
+    Vec3 d1 = Vec3::Zero();
+    for (int i = 0; i < kCount; ++i) {
+      unit[static_cast<std::size_t>(i)].p_world = Vec3(0.0, 0.0, L.mast_top_m * (i + 0.5) / kCount);
+      unit[static_cast<std::size_t>(i)].moment_Am2 = dir;
+      d1 += dipole_field_uT(unit[static_cast<std::size_t>(i)], p_reference);
+    }
+    // Scale s with (h0 + s d1_h) parallel to u, pointing the same way.
+    const Eigen::Vector2d d1h(d1.x(), d1.y());
+    const double den = cross2(u, d1h);
+    if (std::abs(den) < 1e-12) continue;
+    const double s = -cross2(u, h0) / den;
+    if ((h0 + s * d1h).dot(u) <= 0.0) continue;
+    if (std::abs(s) < best_scale) {
+      best_scale = std::abs(s);
+      for (auto& d : unit) d.moment_Am2 *= s;
+      best = unit;
+    }
+  }
+  if (best.empty()) throw std::runtime_error("mast_dipoles: no dipole direction turns the field at the walk");
+  return best;
+}
+
+}  // namespace antpose::sim
