@@ -14,6 +14,7 @@ void add_convert_command(CLI::App& app);
 void add_inspect_command(CLI::App& app);
 void add_wmm_command(CLI::App& app);
 void add_contact_command(CLI::App& app);
+void add_measure_command(CLI::App& app);
 void add_simulate_command(CLI::App& app);
 void add_bench_command(CLI::App& app);
 void add_orientation_command(CLI::App& app);

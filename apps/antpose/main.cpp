@@ -32,6 +32,7 @@ int main(int argc, char** argv) {
   antpose::cli::add_inspect_command(app);
   antpose::cli::add_wmm_command(app);
   antpose::cli::add_contact_command(app);
+  antpose::cli::add_measure_command(app);
   antpose::cli::add_simulate_command(app);
   antpose::cli::add_bench_command(app);
   antpose::cli::add_orientation_command(app);

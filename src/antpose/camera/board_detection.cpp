@@ -29,8 +29,8 @@ bool at_border(const cv::Point2f& p, const cv::Size& size, double margin) {
 }
 
 int count_at_border(const std::vector<cv::Point2f>& points, const cv::Size& size, double margin) {
-  return static_cast<int>(std::count_if(points.begin(), points.end(),
-                                        [&](const cv::Point2f& p) { return at_border(p, size, margin); }));
+  return static_cast<int>(
+      std::count_if(points.begin(), points.end(), [&](const cv::Point2f& p) { return at_border(p, size, margin); }));
 }
 
 void fill_points(BoardDetection& d, const BoardSpec& board, const std::vector<cv::Point2f>& points,
@@ -66,12 +66,13 @@ std::string chessboard_miss_reason(const cv::Mat& grey, const BoardSpec& board, 
   const int m = board.point_count();
   if (!found_part || part.empty()) return fmt::format("no board found (no {}x{} chessboard)", board.cols, board.rows);
   const int n = static_cast<int>(part.size());
-  const bool full = (meta.cols == board.cols && meta.rows == board.rows) ||
-                    (meta.cols == board.rows && meta.rows == board.cols);
+  const bool full =
+      (meta.cols == board.cols && meta.rows == board.rows) || (meta.cols == board.rows && meta.rows == board.cols);
   if (full)
-    return fmt::format("no board found by findChessboardCorners (the sector-based detector sees a {}x{} board; "
-                       "try other detector flags)",
-                       board.cols, board.rows);
+    return fmt::format(
+        "no board found by findChessboardCorners (the sector-based detector sees a {}x{} board; "
+        "try other detector flags)",
+        board.cols, board.rows);
   // A fragment cut by the border: corners next to it, or the fragment's outer row/column within
   // one square spacing of it (the next row would lie outside the image).
   const int n_border = count_at_border(part, grey.size(), o.border_margin_px);
@@ -92,14 +93,49 @@ void detect_chessboard(const cv::Mat& grey, const BoardSpec& board, const Detect
   if (o.fast_check) flags |= cv::CALIB_CB_FAST_CHECK;
   if (o.filter_quads) flags |= cv::CALIB_CB_FILTER_QUADS;
   std::vector<cv::Point2f> corners;
-  if (!cv::findChessboardCorners(grey, cv::Size(board.cols, board.rows), corners, flags)) {
-    d.reason = chessboard_miss_reason(grey, board, o);
+  const int side = std::max(grey.cols, grey.rows);
+  const double f = o.chessboard_search_max_side_px > 0 && side > o.chessboard_search_max_side_px
+                       ? static_cast<double>(o.chessboard_search_max_side_px) / side
+                       : 1.0;
+  cv::Mat search = grey;
+  if (f < 1.0) cv::resize(grey, search, cv::Size(), f, f, cv::INTER_AREA);
+  // findChessboardCorners' quad search takes seconds on a textured scene (gravel, a roof): the
+  // sector-based detector (Duda & Frese, BMVC 2018) finds the board in a fraction of that, and the
+  // classic detector then runs on the board's neighbourhood only, keeping its corner order and
+  // refinement. Where the sector-based one sees nothing, the classic one searches everything, as
+  // it does in photos up to 1024 px (quick there; OpenCV's published samples are that size and
+  // its initial corners, hence the refined ones to 1e-4 px, depend on the search area).
+  const cv::Size pattern(board.cols, board.rows);
+  cv::Rect crop(0, 0, search.cols, search.rows);
+  if (std::vector<cv::Point2f> seen;
+      std::max(search.cols, search.rows) > 1024 && cv::findChessboardCornersSB(search, pattern, seen, 0)) {
+    const cv::Rect box = cv::boundingRect(seen);
+    const int margin =
+        static_cast<int>(std::ceil(2.0 * std::max(box.width / (board.cols - 1.0), box.height / (board.rows - 1.0))));
+    crop = cv::Rect(box.x - margin, box.y - margin, box.width + 2 * margin, box.height + 2 * margin) & crop;
+  }
+  bool found = cv::findChessboardCorners(search(crop), pattern, corners, flags);
+  if (!found && crop.area() < search.cols * search.rows) {
+    crop = cv::Rect(0, 0, search.cols, search.rows);
+    found = cv::findChessboardCorners(search, pattern, corners, flags);
+  }
+  if (!found) {
+    d.reason = chessboard_miss_reason(search, board, o);
     return;
   }
+  for (auto& c : corners) c += cv::Point2f(static_cast<float>(crop.x), static_cast<float>(crop.y));
   const int w = std::max(o.subpix_window, 1);
-  cv::cornerSubPix(grey, corners, cv::Size(w, w), cv::Size(-1, -1),
-                   cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::MAX_ITER, o.subpix_iterations,
-                                    o.subpix_epsilon));
+  const cv::TermCriteria until(cv::TermCriteria::EPS + cv::TermCriteria::MAX_ITER, o.subpix_iterations,
+                               o.subpix_epsilon);
+  if (f < 1.0) {
+    // Refined on the reduced image first (to ~0.1 px there), then taken back to full-size pixel
+    // centres, u = (u' + 0.5) / f − 0.5 (INTER_AREA keeps pixel areas), and refined again there
+    // with the usual window, which a larger one could push into the neighbouring squares.
+    cv::cornerSubPix(search, corners, cv::Size(w, w), cv::Size(-1, -1), until);
+    for (auto& c : corners)
+      c = cv::Point2f(static_cast<float>((c.x + 0.5) / f - 0.5), static_cast<float>((c.y + 0.5) / f - 0.5));
+  }
+  cv::cornerSubPix(grey, corners, cv::Size(w, w), cv::Size(-1, -1), until);
   d.found = true;
   fill_points(d, board, corners, iota_ids(corners.size()));
 }
@@ -185,8 +221,7 @@ void detect_charuco(const cv::Mat& image, const cv::Mat& grey, const BoardSpec& 
     int outside = 0;
     if (!H.empty()) {
       cv::perspectiveTransform(missing_plane, missing_image, H);
-      for (const auto& p : missing_image)
-        outside += p.x < 0 || p.y < 0 || p.x > grey.cols - 1 || p.y > grey.rows - 1;
+      for (const auto& p : missing_image) outside += p.x < 0 || p.y < 0 || p.x > grey.cols - 1 || p.y > grey.rows - 1;
     }
     if (outside > 0 || n_border > 0)
       d.reason = fmt::format("board partly out of view ({} of {} points; {} missing points lie outside the image)", n,
@@ -237,11 +272,11 @@ BoardDetection detect_board(const cv::Mat& image, const BoardSpec& board, const 
   // Blur: corners found on a blurred photo lose their sub-pixel accuracy, so it is refused; a
   // photo without a board that is also blurred (or blank) says both.
   if (options.min_laplacian_variance > 0.0 && d.laplacian_variance < options.min_laplacian_variance) {
-    const std::string blur = fmt::format("variance of Laplacian {:.1f} below {:.1f}", d.laplacian_variance,
-                                         options.min_laplacian_variance);
+    const std::string blur =
+        fmt::format("variance of Laplacian {:.1f} below {:.1f}", d.laplacian_variance, options.min_laplacian_variance);
     if (d.found) {
-      d = BoardDetection{false, "blurred (" + blur + ")", {}, {}, {}, d.markers, d.laplacian_variance, d.width,
-                         d.height};
+      d = BoardDetection{false,     "blurred (" + blur + ")", {},      {},      {},
+                         d.markers, d.laplacian_variance,     d.width, d.height};
     } else {
       d.reason += " in a blurred or blank photo (" + blur + ")";
     }

@@ -46,6 +46,10 @@ struct DetectionOptions {
   double min_laplacian_variance = 30.0;
   // A point closer than this to the image border counts as "at the border" (partial views).
   double border_margin_px = 3.0;
+  // Chessboards in larger photos are found on a copy reduced to this size (findChessboardCorners'
+  // quad search grows with the pixel count: seconds on 12 MP) and their corners then refined by
+  // cornerSubPix on the full image. 0: always full size.
+  int chessboard_search_max_side_px = 2000;
   // ChArUco: minimum number of interpolated corners for a usable view (a homography needs 4;
   // OpenCV's calibration asks for more than 3 per view; 6 gives some redundancy).
   int charuco_min_corners = 6;

@@ -4,6 +4,7 @@
 
 #include <Eigen/Dense>
 #include <fmt/core.h>
+#include <tbb/parallel_for.h>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -56,9 +57,10 @@ std::vector<Vec2> reprojection_residuals(const std::vector<Vec2>& uv, const std:
 std::string image_size_mismatch(int width, int height, const CameraIntrinsics& in) {
   if (width == in.width && height == in.height) return {};
   if (width == in.height && height == in.width)
-    return fmt::format("image is {}x{} px but the intrinsics are for {}x{} px (rotated: portrait vs landscape; "
-                       "photos must be stored in the orientation of the calibration)",
-                       width, height, in.width, in.height);
+    return fmt::format(
+        "image is {}x{} px but the intrinsics are for {}x{} px (rotated: portrait vs landscape; "
+        "photos must be stored in the orientation of the calibration)",
+        width, height, in.width, in.height);
   return fmt::format("image is {}x{} px but the intrinsics are for {}x{} px (another resolution or a cropped photo)",
                      width, height, in.width, in.height);
 }
@@ -145,9 +147,10 @@ std::vector<PhotoBoardPose> board_poses(const Capture& capture, const BoardSpec&
   if (const auto bad = intrinsics.invalid_reason()) throw Error("board poses: intrinsics are " + *bad);
   DetectionOptions options = options_in;
   options.intrinsics = intrinsics;
-  std::vector<PhotoBoardPose> out;
-  out.reserve(capture.shots.size());
-  for (std::size_t i = 0; i < capture.shots.size(); ++i) {
+  // Photos are independent: detected in parallel, their warnings then given in shot order.
+  std::vector<PhotoBoardPose> out(capture.shots.size());
+  std::vector<std::vector<std::string>> notes(capture.shots.size());
+  tbb::parallel_for(std::size_t{0}, capture.shots.size(), [&](std::size_t i) {
     const Shot& shot = capture.shots[i];
     PhotoBoardPose p{i, shot.t, shot.image, std::nullopt, {}, shot.extra};
     const auto file = capture.root / shot.image;
@@ -162,17 +165,21 @@ std::vector<PhotoBoardPose> board_poses(const Capture& capture, const BoardSpec&
       if (!d.found) {
         p.reason = d.reason;
       } else {
-        if (!d.reason.empty()) diagnostics.warn(file, 0, d.reason);
+        if (!d.reason.empty()) notes[i].push_back(d.reason);
         try {
           p.pose = estimate_board_pose(d.image_points, d.object_points, intrinsics);
+          p.image_points_px = d.image_points;
+          p.board_points_m = d.object_points;
         } catch (const MeasurementError& e) {
           p.reason = e.what();
         }
       }
     }
-    if (!p.reason.empty()) diagnostics.warn(file, 0, "photo skipped: " + p.reason);
-    out.push_back(std::move(p));
-  }
+    if (!p.reason.empty()) notes[i].push_back("photo skipped: " + p.reason);
+    out[i] = std::move(p);
+  });
+  for (std::size_t i = 0; i < out.size(); ++i)
+    for (auto& n : notes[i]) diagnostics.warn(capture.root / capture.shots[i].image, 0, std::move(n));
   return out;
 }
 

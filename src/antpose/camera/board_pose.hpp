@@ -52,6 +52,8 @@ struct PhotoBoardPose {
   std::optional<BoardPose> pose;
   std::string reason;              // empty when pose
   std::vector<std::string> extra;  // the shot's extra columns, e.g. placement
+  std::vector<Vec2> image_points_px;  // the detection the pose rests on (empty without a pose)
+  std::vector<Vec3> board_points_m;
 };
 
 /// Detects the board in every photo of the capture and estimates its pose: one entry per shot,

@@ -403,14 +403,7 @@ void validate_capture(Capture& c, const fs::path& folder, Diagnostics& diagnosti
 }
 
 void write_capture(const Capture& c, const fs::path& folder, const CaptureWriteOptions& options) {
-  if (fs::exists(folder) && !options.overwrite)
-    throw InputError(folder, "already exists; choose a new output folder (antpose never overwrites data)");
-  const fs::path parent = folder.parent_path().empty() ? fs::path(".") : folder.parent_path();
-  fs::create_directories(parent);
-  std::random_device rd;
-  const fs::path tmp = parent / fmt::format(".{}.tmp-{:08x}", folder.filename().string(), rd());
-  try {
-    fs::create_directories(tmp);
+  io::write_folder_atomic(folder, options.overwrite, [&](const fs::path& tmp) {
     YAML::Emitter yaml;
     yaml << metadata_yaml(c);
     io::write_text_atomic(tmp / "capture.yaml", std::string(yaml.c_str()) + "\n");
@@ -437,19 +430,7 @@ void write_capture(const Capture& c, const fs::path& folder, const CaptureWriteO
         throw Error(fmt::format("generated file '{}' must be a path inside the capture", rel.string()));
       io::write_text_atomic(tmp / rel, text);
     }
-    if (fs::exists(folder)) {
-      const fs::path old = parent / fmt::format(".{}.old-{:08x}", folder.filename().string(), rd());
-      fs::rename(folder, old);
-      fs::rename(tmp, folder);
-      fs::remove_all(old);
-    } else {
-      fs::rename(tmp, folder);
-    }
-  } catch (...) {
-    std::error_code ignored;
-    fs::remove_all(tmp, ignored);
-    throw;
-  }
+  });
 }
 
 }  // namespace antpose

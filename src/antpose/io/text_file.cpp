@@ -81,12 +81,39 @@ void write_text_atomic(const fs::path& file, std::string_view content) {
   if (!file.parent_path().empty()) fs::create_directories(file.parent_path());
   const fs::path tmp = temporary_sibling(file);
   try {
-    if (is_gzip_name(file)) write_gzip(tmp, content);
-    else write_plain(tmp, content);
+    if (is_gzip_name(file))
+      write_gzip(tmp, content);
+    else
+      write_plain(tmp, content);
     fs::rename(tmp, file);
   } catch (...) {
     std::error_code ignored;
     fs::remove(tmp, ignored);
+    throw;
+  }
+}
+
+void write_folder_atomic(const fs::path& folder, bool overwrite, const std::function<void(const fs::path&)>& fill) {
+  if (fs::exists(folder) && !overwrite)
+    throw InputError(folder, "already exists; choose a new output folder (antpose never overwrites data)");
+  const fs::path parent = folder.parent_path().empty() ? fs::path(".") : folder.parent_path();
+  fs::create_directories(parent);
+  std::random_device rd;
+  const fs::path tmp = parent / fmt::format(".{}.tmp-{:08x}", folder.filename().string(), rd());
+  try {
+    fs::create_directories(tmp);
+    fill(tmp);
+    if (fs::exists(folder)) {
+      const fs::path old = parent / fmt::format(".{}.old-{:08x}", folder.filename().string(), rd());
+      fs::rename(folder, old);
+      fs::rename(tmp, folder);
+      fs::remove_all(old);
+    } else {
+      fs::rename(tmp, folder);
+    }
+  } catch (...) {
+    std::error_code ignored;
+    fs::remove_all(tmp, ignored);
     throw;
   }
 }

@@ -1,0 +1,183 @@
+// antpose measure: the non-contact measurement (docs/non-contact.md).
+//   antpose measure CAPTURE --device ID|FILE [--model MESH|BUILTIN [--model-box BOX] [--model-units m|mm]]
+//       --roi IMAGE:x,y,w,h [--roi ...] [--json OUT] [--report DIR [--force]]
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "antpose/camera/board.hpp"
+#include "antpose/imu/imu_calibration.hpp"
+#include "antpose/io/text_file.hpp"
+#include "antpose/measure/non_contact.hpp"
+#include "antpose/measure/report.hpp"
+#include "antpose/model/antenna_model.hpp"
+#include "antpose/store/device_ref.hpp"
+#include "commands.hpp"
+
+namespace antpose::cli {
+namespace {
+namespace fs = std::filesystem;
+
+struct MeasureArgs {
+  std::string capture, device, model, model_box, model_units = "m", json, report, orientation = "antpose-smoother";
+  std::optional<std::string> db;
+  std::vector<std::string> rois;
+  bool model_canonical = false, force = false;
+};
+
+std::optional<model::AntennaModel> load_model(const MeasureArgs& a) {
+  if (a.model.empty()) {
+    if (!a.model_box.empty()) throw InputError(a.model_box, "--model-box needs --model (the mesh it belongs to)");
+    return std::nullopt;
+  }
+  const auto names = model::builtin_panel_names();
+  if (!fs::exists(a.model) && std::find(names.begin(), names.end(), a.model) != names.end())
+    return model::builtin_panel(a.model);
+  if (!fs::exists(a.model)) {
+    std::string list;
+    for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;
+    throw InputError(a.model, "--model: no such file, and not a built-in panel (" + list + ")");
+  }
+  model::Units units = model::Units::kMetres;
+  if (a.model_units == "mm")
+    units = model::Units::kMillimetres;
+  else if (a.model_units != "m")
+    throw InputError("--model-units", fmt::format("'{}' is not m or mm", a.model_units));
+  return model::load_antenna_model(a.model, a.model_box.empty() ? std::nullopt : std::optional<fs::path>(a.model_box),
+                                   units, a.model_canonical);
+}
+
+measure::NonContactSetup setup_from(const MeasureArgs& a, const store::DeviceProfile& device, const fs::path& where) {
+  measure::NonContactSetup s;
+  if (!device.camera)
+    throw InputError(where, "the device has no camera intrinsics: run 'antpose calibrate camera --device' first");
+  if (!device.camera_imu)
+    throw InputError(where,
+                     "the device has no camera–IMU rotation (R_device_camera): run 'antpose calibrate joint "
+                     "--device' first; the nominal layout is off by degrees on real phones");
+  s.intrinsics = device.camera->intrinsics;
+  s.camera_imu.R_device_camera = device.camera_imu->R_device_camera;
+  s.camera_imu.time_offset_s = device.camera_imu->time_offset_s;
+  if (device.camera_imu->rotation_sigma_rad)
+    s.camera_imu.covariance = device.camera_imu->rotation_sigma_rad->cwiseAbs2().asDiagonal();
+  s.board = camera::read_board(fs::path(a.capture) / "board.yaml");
+  s.model = load_model(a);
+  for (const auto& r : a.rois) s.rois.push_back(measure::parse_roi(r));
+  return s;
+}
+
+std::string cell(const std::optional<double>& v, const std::optional<double>& sigma, int digits) {
+  if (!v) return "undefined";
+  return fmt::format("{:.{}f} ± {:.{}f}", rad2deg(*v), digits, rad2deg(sigma.value_or(0.0)), digits);
+}
+
+void print_table(const measure::NonContactResult& r) {
+  fmt::print(
+      "{} photos, board found in {}, board attitude from {}; camera poses {:.2f} px (board) / {:.2f} px "
+      "(scene, {} tracks)\n",
+      r.photos.size(), r.posed.size(), r.board.used, r.poses.board_rms_px, r.poses.scene_rms_px, r.poses.tracks);
+  if (r.site) fmt::print("declination {:.2f}° (WMM2025, east positive)\n", rad2deg(r.site->declination));
+  fmt::print("{:>3}  {:<22} {:>16} {:>16} {:>14} {:>14} {:>8} {:>7}\n", "#", "photo", "azimuth mag °", "azimuth true °",
+             "downtilt °", "roll °", "fit mm", "points");
+  for (std::size_t k = 0; k < r.antennas.size(); ++k) {
+    const auto& m = r.antennas[k];
+    const auto photo = fs::path(m.roi.image).filename().string();
+    if (m.error) {
+      fmt::print("{:>3}  {:<22} FAILED: {}\n", k + 1, photo, *m.error);
+      continue;
+    }
+    const auto& a = m.attitude;
+    fmt::print("{:>3}  {:<22} {:>16} {:>16} {:>14} {:>14} {:>8.1f} {:>7}\n", k + 1, photo,
+               cell(a.magnetic.azimuth, a.sigma.azimuth, 2),
+               r.site ? cell(a.azimuth_true, a.azimuth_true_sigma, 2) : std::string("no site"),
+               cell(a.magnetic.downtilt, a.sigma.downtilt, 2), cell(a.magnetic.roll, a.sigma.roll, 2),
+               1e3 * m.fit_rmse_m, m.region.cloud_board.size());
+  }
+}
+
+int run_measure(const MeasureArgs& a) {
+  if (a.rois.empty())
+    throw InputError("--roi", "at least one --roi IMAGE:x,y,w,h is needed (the antenna in one photo)");
+  const auto ref = store::resolve_device_ref(a.device, a.db ? std::optional<fs::path>(*a.db) : std::nullopt);
+  const fs::path where = ref.file ? *ref.file : fs::path("--device " + ref.profile.id);
+  const auto setup = setup_from(a, ref.profile, where);
+  if (!a.report.empty() && fs::exists(a.report) && !fs::is_empty(a.report) && !a.force)
+    throw InputError(a.report, "already exists and is not empty; choose a new report folder or add --force");
+
+  Diagnostics diagnostics;
+  Capture capture = read_capture(a.capture, diagnostics);
+  if (ref.profile.has_imu) {
+    imu::apply(ref.profile.imu, capture);
+  } else {
+    diagnostics.warn(where, 0,
+                     "the device has no IMU calibration: the magnetometer's hard iron turns the azimuth by "
+                     "degrees; run 'antpose calibrate imu --device' first");
+  }
+
+  measure::NonContactOptions options;
+  options.orientation = a.orientation;
+  const auto start = std::chrono::steady_clock::now();
+  options.progress = [&](const std::string& stage, int done, int total) {
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    fmt::print(stderr, "\r\033[K[{:5.1f} s] {} {}/{}", s, stage, done, total);
+    if (done == total) fmt::print(stderr, "\n");
+    std::fflush(stderr);
+  };
+  const auto result = measure::measure_non_contact(capture, setup, options, diagnostics);
+  print_warnings(diagnostics);
+  print_table(result);
+  Diagnostics result_warnings;
+  for (const auto& w : result.warnings) result_warnings.warn(w);
+  for (std::size_t k = 0; k < result.antennas.size(); ++k) {
+    const auto& m = result.antennas[k];
+    if (!m.error)
+      for (const auto& w : m.attitude.warnings) result_warnings.warn(fmt::format("antenna {}: {}", k + 1, w));
+    for (const auto& w : m.warnings) result_warnings.warn(fmt::format("antenna {}: {}", k + 1, w));
+  }
+  print_warnings(result_warnings);
+  if (!a.json.empty()) io::write_text_atomic(a.json, measure::to_json(result).dump(2) + "\n");
+  if (!a.report.empty()) {
+    measure::write_report(a.report, capture, setup, result, a.force);
+    fmt::print("report: {}\n", (fs::path(a.report) / "index.html").string());
+  }
+  for (const auto& m : result.antennas)
+    if (m.error) return 3;
+  return 0;
+}
+
+}  // namespace
+
+void add_measure_command(CLI::App& app) {
+  auto a = std::make_shared<MeasureArgs>();
+  auto* cmd = app.add_subcommand("measure", "antenna azimuth, downtilt and roll from photos with the board in view");
+  cmd->add_option("capture", a->capture, "native capture folder (photos, shots.csv, board.yaml, IMU streams)")
+      ->required();
+  cmd->add_option("--device", a->device,
+                  "the phone: a device id in the database or a profile YAML file (intrinsics, "
+                  "camera-IMU rotation, IMU calibration)")
+      ->required();
+  cmd->add_option("--db", a->db, "device database (default as 'antpose device')");
+  cmd->add_option("--model", a->model,
+                  "antenna model: an OBJ/PLY mesh or a built-in panel name; without it the model-free face fit");
+  cmd->add_option("--model-box", a->model_box, "the mesh's A–H box file (fixes the antenna frame)");
+  cmd->add_option("--model-units", a->model_units, "units of the mesh and box: m or mm")->capture_default_str();
+  cmd->add_flag("--model-canonical", a->model_canonical, "the mesh is already in the antenna frame (no box file)");
+  cmd->add_option("--roi", a->rois, "IMAGE:x,y,w,h: the antenna's rectangle in one photo (px); once per antenna")
+      ->required();
+  cmd->add_option("--orientation", a->orientation, "phone orientation method")->capture_default_str();
+  cmd->add_option("--json", a->json, "write the result as JSON to this file");
+  cmd->add_option("--report", a->report, "write a report folder (HTML, overlays, PLY clouds)");
+  cmd->add_flag("--force", a->force, "replace an existing report folder");
+  cmd->callback([a] {
+    const int status = run_measure(*a);
+    if (status != 0) throw CLI::RuntimeError(status);
+  });
+}
+
+}  // namespace antpose::cli
