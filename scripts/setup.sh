@@ -12,7 +12,10 @@ DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recomme
   zlib1g-dev libpugixml-dev libgtest-dev libgmock-dev libbenchmark-dev
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release
 cmake --build build -j2
-# The main job on the bundled sample: calibrate the phone's magnetometer from its tumble
-# recording, then measure the antenna plate in contact mode.
+# The main job on the bundled samples: the non-contact measurement of a rooftop antenna from
+# photos with the board in view (examples/README.md gives the truth), then the contact
+# measurement of an antenna plate after calibrating the phone's magnetometer from its tumble.
+./build/apps/antpose/antpose measure examples/antenna-sample --device examples/antenna-phone.yaml \
+  --model thesis-1310x159x80 --roi images/img_0004.jpg:1467,1522,559,120 --report build/antenna-report --force
 ./build/apps/antpose/antpose calibrate imu examples/imu-calibration-sample --sensors mag -o build/sample-device.yaml --force
 ./build/apps/antpose/antpose contact examples/contact-sample --imu-calibration build/sample-device.yaml

@@ -1,6 +1,7 @@
 // antpose measure: the non-contact measurement (docs/non-contact.md).
 //   antpose measure CAPTURE --device ID|FILE [--model MESH|BUILTIN [--model-box BOX] [--model-units m|mm]]
 //       --roi IMAGE:x,y,w,h [--roi ...] [--json OUT] [--report DIR [--force]]
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -25,32 +26,42 @@ namespace {
 namespace fs = std::filesystem;
 
 struct MeasureArgs {
-  std::string capture, device, model, model_box, model_units = "m", json, report, orientation = "antpose-smoother";
+  std::string capture, device, model_units = "m", json, report, orientation = "antpose-smoother";
   std::optional<std::string> db;
-  std::vector<std::string> rois;
+  std::vector<std::string> rois, models, model_boxes;
   bool model_canonical = false, force = false;
 };
 
-std::optional<model::AntennaModel> load_model(const MeasureArgs& a) {
-  if (a.model.empty()) {
-    if (!a.model_box.empty()) throw InputError(a.model_box, "--model-box needs --model (the mesh it belongs to)");
-    return std::nullopt;
-  }
+// A built-in panel name, or a mesh file with (optionally) its box file.
+model::AntennaModel load_model(const std::string& name, const std::string& box, const MeasureArgs& a) {
   const auto names = model::builtin_panel_names();
-  if (!fs::exists(a.model) && std::find(names.begin(), names.end(), a.model) != names.end())
-    return model::builtin_panel(a.model);
-  if (!fs::exists(a.model)) {
+  if (!fs::exists(name) && std::find(names.begin(), names.end(), name) != names.end()) {
+    if (!box.empty()) throw InputError(box, "--model-box: '" + name + "' is a built-in panel, which has its box");
+    return model::builtin_panel(name);
+  }
+  if (!fs::exists(name)) {
     std::string list;
     for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;
-    throw InputError(a.model, "--model: no such file, and not a built-in panel (" + list + ")");
+    throw InputError(name, "--model: no such file, and not a built-in panel (" + list + ")");
   }
   model::Units units = model::Units::kMetres;
   if (a.model_units == "mm")
     units = model::Units::kMillimetres;
   else if (a.model_units != "m")
     throw InputError("--model-units", fmt::format("'{}' is not m or mm", a.model_units));
-  return model::load_antenna_model(a.model, a.model_box.empty() ? std::nullopt : std::optional<fs::path>(a.model_box),
-                                   units, a.model_canonical);
+  return model::load_antenna_model(name, box.empty() ? std::nullopt : std::optional<fs::path>(box), units,
+                                   a.model_canonical);
+}
+
+// --model once for every antenna or once per --roi; --model-box, when given, pairs with them.
+std::vector<model::AntennaModel> load_models(const MeasureArgs& a) {
+  if (!a.model_boxes.empty() && a.model_boxes.size() != a.models.size())
+    throw InputError("--model-box", fmt::format("{} box files for {} models: give one per --model, in the same order",
+                                                a.model_boxes.size(), a.models.size()));
+  std::vector<model::AntennaModel> models;
+  for (std::size_t i = 0; i < a.models.size(); ++i)
+    models.push_back(load_model(a.models[i], a.model_boxes.empty() ? std::string() : a.model_boxes[i], a));
+  return models;
 }
 
 measure::NonContactSetup setup_from(const MeasureArgs& a, const store::DeviceProfile& device, const fs::path& where) {
@@ -67,7 +78,7 @@ measure::NonContactSetup setup_from(const MeasureArgs& a, const store::DevicePro
   if (device.camera_imu->rotation_sigma_rad)
     s.camera_imu.covariance = device.camera_imu->rotation_sigma_rad->cwiseAbs2().asDiagonal();
   s.board = camera::read_board(fs::path(a.capture) / "board.yaml");
-  s.model = load_model(a);
+  s.models = load_models(a);
   for (const auto& r : a.rois) s.rois.push_back(measure::parse_roi(r));
   return s;
 }
@@ -136,8 +147,10 @@ int run_measure(const MeasureArgs& a) {
   for (const auto& w : result.warnings) result_warnings.warn(w);
   for (std::size_t k = 0; k < result.antennas.size(); ++k) {
     const auto& m = result.antennas[k];
-    if (!m.error)
-      for (const auto& w : m.attitude.warnings) result_warnings.warn(fmt::format("antenna {}: {}", k + 1, w));
+    if (!m.error)  // the board's warnings are the capture's, printed once
+      for (const auto& w : m.attitude.warnings)
+        if (std::find(result.warnings.begin(), result.warnings.end(), w) == result.warnings.end())
+          result_warnings.warn(fmt::format("antenna {}: {}", k + 1, w));
     for (const auto& w : m.warnings) result_warnings.warn(fmt::format("antenna {}: {}", k + 1, w));
   }
   print_warnings(result_warnings);
@@ -163,9 +176,10 @@ void add_measure_command(CLI::App& app) {
                   "camera-IMU rotation, IMU calibration)")
       ->required();
   cmd->add_option("--db", a->db, "device database (default as 'antpose device')");
-  cmd->add_option("--model", a->model,
-                  "antenna model: an OBJ/PLY mesh or a built-in panel name; without it the model-free face fit");
-  cmd->add_option("--model-box", a->model_box, "the mesh's A–H box file (fixes the antenna frame)");
+  cmd->add_option("--model", a->models,
+                  "antenna model: an OBJ/PLY mesh or a built-in panel name, once for all antennas or once per --roi; "
+                  "without it the model-free face fit");
+  cmd->add_option("--model-box", a->model_boxes, "the mesh's A–H box file (fixes the antenna frame), one per --model");
   cmd->add_option("--model-units", a->model_units, "units of the mesh and box: m or mm")->capture_default_str();
   cmd->add_flag("--model-canonical", a->model_canonical, "the mesh is already in the antenna frame (no box file)");
   cmd->add_option("--roi", a->rois, "IMAGE:x,y,w,h: the antenna's rectangle in one photo (px); once per antenna")

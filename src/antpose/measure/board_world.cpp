@@ -14,8 +14,13 @@ void warn(Diagnostics& d, std::vector<std::string>& warnings, std::string messag
   d.warn(std::move(message));
 }
 
-/// Covariance of the track at t (world), or a generic phone's when the track has none.
-Mat3 track_covariance(const orientation::OrientationTrack& track, double t) {
+/// Covariance of the track at t (world): the options' calibrated model when set, else the
+/// track's own, else a generic phone's when the track has none.
+Mat3 track_covariance(const orientation::OrientationTrack& track, double t, const BoardWorldOptions& options) {
+  if (options.common_sigma_rad) {
+    const double tilt = options.common_sigma_rad->x(), heading = options.common_sigma_rad->y();
+    return Vec3(tilt * tilt, tilt * tilt, heading * heading).asDiagonal();
+  }
   const auto s = track.at(t);
   if (s.covariance && s.covariance->allFinite() && s.covariance->trace() > 0.0) return *s.covariance;
   const double tilt = deg2rad(0.5), heading = deg2rad(3.0);
@@ -41,8 +46,9 @@ Mat3 l1_rotation_median(const std::vector<Mat3>& rotations, int max_iterations) 
   return R;
 }
 
-BoardWorldAttitude board_world_attitude(const std::vector<BoardPhoto>& photos, const orientation::OrientationTrack& track,
-                                        const CameraImu& ci, const BoardWorldOptions& o, Diagnostics& diagnostics) {
+BoardWorldAttitude board_world_attitude(const std::vector<BoardPhoto>& photos,
+                                        const orientation::OrientationTrack& track, const CameraImu& ci,
+                                        const BoardWorldOptions& o, Diagnostics& diagnostics) {
   BoardWorldAttitude out;
   std::vector<std::size_t> inside;
   std::vector<Mat3> R_wb(photos.size()), R_wd(photos.size());
@@ -60,9 +66,10 @@ BoardWorldAttitude board_world_attitude(const std::vector<BoardPhoto>& photos, c
     inside.push_back(i);
   }
   if (inside.size() < o.min_photos)
-    throw MeasurementError(fmt::format("board attitude in the world: {} photo(s) with a board pose and a phone "
-                                       "orientation, at least {} needed",
-                                       inside.size(), o.min_photos));
+    throw MeasurementError(
+        fmt::format("board attitude in the world: {} photo(s) with a board pose and a phone "
+                    "orientation, at least {} needed",
+                    inside.size(), o.min_photos));
 
   // Median, outliers, median again without them.
   std::vector<Mat3> all;
@@ -71,13 +78,16 @@ BoardWorldAttitude board_world_attitude(const std::vector<BoardPhoto>& photos, c
   std::vector<std::size_t> used;
   std::vector<std::string> outliers;
   for (std::size_t i : inside) {
-    if (rad2deg(rotation_distance(R_wb[i], first)) > o.outlier_deg) outliers.push_back(photos[i].name);
-    else used.push_back(i);
+    if (rad2deg(rotation_distance(R_wb[i], first)) > o.outlier_deg)
+      outliers.push_back(photos[i].name);
+    else
+      used.push_back(i);
   }
   if (used.size() < o.min_photos)
-    throw MeasurementError(fmt::format("board attitude in the world: the photos disagree by more than {}° (outliers: "
-                                       "{}); check the board detection and the phone's orientation",
-                                       o.outlier_deg, fmt::join(outliers, ", ")));
+    throw MeasurementError(
+        fmt::format("board attitude in the world: the photos disagree by more than {}° (outliers: "
+                    "{}); check the board detection and the phone's orientation",
+                    o.outlier_deg, fmt::join(outliers, ", ")));
   if (!outliers.empty())
     warn(diagnostics, out.warnings,
          fmt::format("{} photo(s) imply a board attitude more than {}° from the others and are left out: {}",
@@ -102,7 +112,7 @@ BoardWorldAttitude board_world_attitude(const std::vector<BoardPhoto>& photos, c
     scatter += v * v.transpose() / n;
     heading_sq += v.z() * v.z() / n;
     const double t = photos[i].t_shot + ci.time_offset_s;
-    common += (track_covariance(track, t) + R_wd[i] * ci.covariance * R_wd[i].transpose()) / n;
+    common += (track_covariance(track, t, o) + R_wd[i] * ci.covariance * R_wd[i].transpose()) / n;
     const Mat3 R_wc = R_wd[i] * ci.R_device_camera;
     pnp += R_wc * photos[i].cov_R_camera_board * R_wc.transpose() / (n * n);
   }
@@ -120,7 +130,8 @@ BoardWorldAttitude board_world_attitude(const std::vector<BoardPhoto>& photos, c
     for (std::size_t b = a + 1; b < used.size(); ++b) {
       const Vec3 ca = -(photos[used[a]].R_camera_board.transpose() * photos[used[a]].t_camera_board);
       const Vec3 cb = -(photos[used[b]].R_camera_board.transpose() * photos[used[b]].t_camera_board);
-      if (ca.norm() > 0 && cb.norm() > 0) out.view_spread_deg = std::max(out.view_spread_deg, rad2deg(angle_between(ca, cb)));
+      if (ca.norm() > 0 && cb.norm() > 0)
+        out.view_spread_deg = std::max(out.view_spread_deg, rad2deg(angle_between(ca, cb)));
     }
   if (out.view_spread_deg < o.min_view_spread_deg)
     warn(diagnostics, out.warnings,

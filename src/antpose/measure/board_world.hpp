@@ -17,6 +17,7 @@
 #pragma once
 
 #include <cstddef>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -46,6 +47,9 @@ struct BoardWorldOptions {
   double min_view_spread_deg = 15.0;      // largest angle between two viewing directions
   std::size_t min_photos = 2;
   int max_iterations = 100;
+  /// (tilt per axis, heading) 1σ of the orientation error common to a capture, rad, replacing
+  /// the track's covariance (e.g. when that is a weighting heuristic rather than calibrated).
+  std::optional<Vec2> common_sigma_rad;
 };
 
 struct BoardPhotoResidual {
@@ -56,7 +60,7 @@ struct BoardPhotoResidual {
 
 struct BoardWorldAttitude {
   Mat3 R_world_board = Mat3::Identity();
-  Mat3 covariance = Mat3::Zero();  // rad², world frame
+  Mat3 covariance = Mat3::Zero();          // rad², world frame
   std::vector<BoardPhotoResidual> photos;  // one per input photo, in order
   std::size_t used = 0;
   double heading_scatter_deg = 0.0;  // RMS over the photos used
@@ -66,9 +70,9 @@ struct BoardWorldAttitude {
 
 /// MeasurementError when fewer than options.min_photos photos lie inside the track, or fewer
 /// remain after outliers (naming them).
-BoardWorldAttitude board_world_attitude(const std::vector<BoardPhoto>& photos, const orientation::OrientationTrack& track,
-                                        const CameraImu& camera_imu, const BoardWorldOptions& options,
-                                        Diagnostics& diagnostics);
+BoardWorldAttitude board_world_attitude(const std::vector<BoardPhoto>& photos,
+                                        const orientation::OrientationTrack& track, const CameraImu& camera_imu,
+                                        const BoardWorldOptions& options, Diagnostics& diagnostics);
 
 /// The geodesic L1 median of rotations (Weiszfeld), started from their chordal mean.
 Mat3 l1_rotation_median(const std::vector<Mat3>& rotations, int max_iterations = 100);

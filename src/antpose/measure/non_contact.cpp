@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <random>
 #include <tuple>
@@ -91,43 +92,202 @@ double extent_along(const PointCloud& cloud, const Vec3& axis) {
   return cloud.empty() ? 0.0 : hi - lo;
 }
 
-void register_model(AntennaMeasurement& m, const model::AntennaModel& model, const PointCloud& model_cloud,
-                    const registration::PreparedCloud& model_prepared, const std::vector<Vec3>& viewpoints,
-                    const Vec3& up_board, const NonContactOptions& options) {
+// The magnetometer around each photo (±half_window_s, in the world frame through the track)
+// against the Earth's field: WMM's at the site, else the capture's own median. A steel mast turns
+// the field's horizontal part, which moves its strength and dip too; by how much, says the
+// warning. Returns the warnings.
+std::vector<std::string> field_check(const orientation::ImuData& data, const orientation::OrientationTrack& track,
+                                     const std::vector<double>& shot_t, const std::optional<geomag::SiteField>& site,
+                                     const NonContactOptions& options) {
+  std::vector<std::string> warnings;
+  if (!data.has_magnetometer()) return warnings;
+  std::vector<double> strength, dip;
+  for (const double t : shot_t) {
+    Vec3 sum = Vec3::Zero();
+    int n = 0;
+    const auto& m = data.magnetometer;
+    for (std::size_t i = 0; i < m.size(); ++i)
+      if (std::abs(m.t[i] - t) <= options.field_half_window_s && track.contains(m.t[i]))
+        sum += track.at(m.t[i]).q_world_device * m.v[i], ++n;
+    if (n == 0) continue;
+    const Vec3 b = sum / n;
+    strength.push_back(b.norm());
+    dip.push_back(std::asin(std::clamp(-b.z() / b.norm(), -1.0, 1.0)));
+  }
+  if (strength.empty()) return warnings;
+  auto median = [](std::vector<double> v) {
+    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+    return v[v.size() / 2];
+  };
+  const double f_ref = site ? site->elements.f_nT / 1000.0 : median(strength);
+  const double dip_ref = site ? site->inclination : median(dip);
+  double worst_f = 0.0, worst_dip = 0.0;
+  for (std::size_t i = 0; i < strength.size(); ++i) {
+    worst_f = std::max(worst_f, std::abs(strength[i] - f_ref) / f_ref);
+    worst_dip = std::max(worst_dip, std::abs(dip[i] - dip_ref));
+  }
+  if (worst_f > options.field_tolerance || worst_dip > options.dip_tolerance)
+    warnings.push_back(fmt::format(
+        "magnetic disturbance: at the photos the field differs from {} by up to {:.1f} % in strength and {:.1f}° in "
+        "dip (limits {:.0f} %, {:.1f}°): steel nearby turns the compass, and the azimuth may be off by degrees",
+        site ? "the WMM's at the site" : "its median over the photos", 100 * worst_f, rad2deg(worst_dip),
+        100 * options.field_tolerance, rad2deg(options.dip_tolerance)));
+  return warnings;
+}
+
+// What the registration of every antenna shares.
+struct Scene {
+  const std::vector<PosedView>& views;
+  const camera::CameraIntrinsics& intrinsics;
+  std::vector<Vec3> viewpoints;  // camera centres, board frame
+  Vec3 up_board;
+};
+
+// The silhouette stage: starts turned about the vertical from the points' pose by each start
+// angle, refined by the outline in every photo; the converged result with the lowest score (the
+// outline's mean truncated edge cost) wins. `rival_deg`: the largest boresight angle to another
+// converged result scoring within options.silhouette_rival_margin of the winner.
+struct SilhouettePick {
+  std::optional<registration::SilhouetteResult> best;
+  double rival_deg = 0.0;
+  int converged = 0, tried = 0;
+};
+
+SilhouettePick silhouette_search(const model::AntennaModel& model, const Iso3& T_board_antenna, const Scene& scene,
+                                 const NonContactOptions& options) {
+  // No ROI: each start's crop follows its projection (a carried ROI may cut the outline).
+  std::vector<registration::SilhouetteView> views;
+  for (const auto& v : scene.views) views.push_back({v.image, v.R_camera_board, v.t_camera_board, {}});
+  SilhouettePick pick;
+  std::vector<registration::SilhouetteResult> done;
+  // Starts upright (the long axis along the board frame's up: panels hang within ~15° of it),
+  // turned about it from the points' boresight, at the points' position. The points' own tilt
+  // is not kept: on a cluttered region it can be the wrong basin for the outline.
+  const Vec3 up = scene.up_board.normalized();
+  Vec3 ahead = T_board_antenna.linear().col(1) - T_board_antenna.linear().col(1).dot(up) * up;
+  if (ahead.norm() < 1e-6) ahead = up.unitOrthogonal();
+  ahead.normalize();
+  for (const double yaw : options.silhouette_yaw_starts_deg) {
+    Iso3 start = T_board_antenna;
+    const Vec3 y = Eigen::AngleAxisd(deg2rad(yaw), up) * ahead;
+    start.linear().col(0) = y.cross(up);
+    start.linear().col(1) = y;
+    start.linear().col(2) = up;
+    ++pick.tried;
+    auto r = registration::refine_by_silhouette(model.mesh_antenna, start, views, scene.intrinsics,
+                                                options.silhouette_options);
+    if (r.converged) done.push_back(std::move(r));
+  }
+  pick.converged = static_cast<int>(done.size());
+  if (done.empty()) return pick;
+  std::sort(done.begin(), done.end(), [](const auto& a, const auto& b) { return a.score < b.score; });
+  const Vec3 boresight = done.front().T_board_antenna.linear().col(1);
+  for (std::size_t i = 1; i < done.size(); ++i) {
+    if (done[i].score - done.front().score > options.silhouette_rival_margin) break;
+    const double angle = rad2deg(angle_between(done[i].T_board_antenna.linear().col(1), boresight));
+    if (angle > options.rival_min_deg && angle < 135.0) pick.rival_deg = std::max(pick.rival_deg, angle);
+  }
+  pick.best = std::move(done.front());
+  return pick;
+}
+
+void register_model(AntennaMeasurement& m, const model::AntennaModel& model, const Scene& scene,
+                    const NonContactOptions& options) {
+  const PointCloud model_cloud = model::sample_surface(model.mesh_antenna, options.model_spacing_m, options.seed);
+  const auto model_prepared = registration::prepare(model_cloud, options.registration.fine);
   auto gopts = options.registration;
-  gopts.viewpoints_scene = viewpoints;
-  const auto scene = registration::prepare(m.region.cloud_board, gopts.fine);
-  const auto g = registration::global_align(scene, model_prepared, up_board, gopts);
-  const Iso3 T_antenna_board = g.fit.T_target_source;
-  m.method = "model " + model.name;
+  gopts.viewpoints_scene = scene.viewpoints;
+  const auto cloud = registration::prepare(m.region.cloud_board, gopts.fine);
+  const auto g = registration::global_align(cloud, model_prepared, scene.up_board, gopts);
+  Iso3 T_antenna_board = g.fit.T_target_source;
+  m.method = "model " + model.name + ", points";
+  m.front_back_margin = g.front_back_margin;
+
+  // The outline decides the yaw where the points cannot (docs/non-contact.md).
+  double rival_deg = 0.0;
+  std::optional<Mat3> cov_silhouette;
+  if (options.silhouette) {
+    const auto pick = silhouette_search(model, T_antenna_board.inverse(), scene, options);
+    if (pick.best) {
+      T_antenna_board = pick.best->T_board_antenna.inverse();
+      cov_silhouette = pick.best->covariance.topLeftCorner<3, 3>();
+      rival_deg = pick.rival_deg;
+      m.silhouette_rms_px = pick.best->rms_px;
+      m.method = fmt::format("model {}, points + outline in {} photos", model.name, pick.best->views_used);
+      for (const auto& w : pick.best->warnings) m.warnings.push_back("outline: " + w);
+    } else {
+      m.warnings.push_back(
+          fmt::format("the model's outline matched the photos from none of {} starts: the yaw rests on "
+                      "the points alone",
+                      pick.tried));
+    }
+  }
   m.R_board_antenna = T_antenna_board.rotation().transpose();
   m.p_board_antenna = T_antenna_board.inverse().translation();
-  m.fit_rmse_m = g.fit.rmse_m;
-  m.fitness = g.fit.fitness;
-  m.front_back_margin = g.front_back_margin;
-  if (!(m.fitness >= options.fail_fitness) || !(m.fit_rmse_m <= options.fail_rmse_m))
+
+  // The points' agreement with the final pose.
+  const double reach = gopts.fine.max_correspondence_distance_m;
+  double ss = 0.0;
+  std::size_t near = 0;
+  for (const auto& p : m.region.cloud_board.points) {
+    std::size_t index = 0;
+    double d2 = 0.0;
+    if (model_prepared.tree.nearest(T_antenna_board * p, index, d2) && d2 <= reach * reach) ss += d2, ++near;
+  }
+  m.fitness = m.region.cloud_board.empty() ? 0.0 : static_cast<double>(near) / m.region.cloud_board.size();
+  m.fit_rmse_m = near ? std::sqrt(ss / near) : std::numeric_limits<double>::infinity();
+  // With the outline deciding the pose the points only place it, and clutter (mast, arms) may
+  // outnumber them; without it they must carry the fit.
+  const double fail_fitness = cov_silhouette ? options.fail_fitness_with_outline : options.fail_fitness;
+  if (!(m.fitness >= fail_fitness) || !(m.fit_rmse_m <= options.fail_rmse_m))
     throw MeasurementError(fmt::format(
         "the region's {} points do not fit the model '{}': {:.0f} % of them lie within {:.0f} mm of it, RMS {:.1f} mm "
         "(at least {:.0f} % and at most {:.0f} mm expected). Is the rectangle on the antenna, and is the model this "
         "antenna's?",
-        m.region.cloud_board.size(), model.name, 100 * m.fitness, 1e3 * gopts.fine.max_correspondence_distance_m,
-        1e3 * m.fit_rmse_m, 100 * options.fail_fitness, 1e3 * options.fail_rmse_m));
+        m.region.cloud_board.size(), model.name, 100 * m.fitness, 1e3 * reach, 1e3 * m.fit_rmse_m, 100 * fail_fitness,
+        1e3 * options.fail_rmse_m));
   if (m.fit_rmse_m > options.warn_rmse_m)
     m.warnings.push_back(fmt::format("poor registration fit: RMS {:.1f} mm (more than {:.0f} mm)", 1e3 * m.fit_rmse_m,
                                      1e3 * options.warn_rmse_m));
-  if (g.front_back_ambiguous)
-    m.warnings.push_back(fmt::format(
-        "front and back are ambiguous: the model turned 180° fits nearly as well (margin {:.3f}); photograph the "
-        "antenna from further round its side, or check the azimuth by eye",
-        g.front_back_margin));
+  if (m.fitness < options.warn_fitness)
+    m.warnings.push_back(
+        fmt::format("only {:.0f} % of the region's points lie near the registered model: the region "
+                    "holds other objects (mast, arms) or the reconstruction is noisy",
+                    100 * m.fitness));
+  if (!cov_silhouette) {
+    if (g.front_back_ambiguous)
+      m.warnings.push_back(fmt::format(
+          "front and back are ambiguous: the model turned 180° fits nearly as well (margin {:.3f}); photograph the "
+          "antenna from further round its side, or check the azimuth by eye",
+          g.front_back_margin));
+    // Any other yaw that fits the points nearly as well (coarse scores) makes the azimuth that uncertain.
+    const Vec3 boresight = m.R_board_antenna.col(1);
+    for (const auto& h : g.hypotheses) {
+      const double angle = rad2deg(angle_between(h.T_model_scene.rotation().transpose().col(1), boresight));
+      if (angle > options.rival_min_deg && angle <= 90.0 &&
+          h.score() - g.hypotheses.front().score() < gopts.ambiguity_margin)
+        rival_deg = std::max(rival_deg, angle);
+    }
+  }
   const double covered = extent_along(m.region.cloud_board, m.R_board_antenna.col(2));
   if (covered < 0.6 * model.size_m.z())
     m.warnings.push_back(
         fmt::format("the points cover {:.2f} m of the {:.2f} m long panel: enlarge the rectangle to "
                     "the whole antenna",
                     covered, model.size_m.z()));
-  const Mat3 cov_antenna = bootstrap_covariance(m.region.cloud_board, model_prepared, T_antenna_board, options);
-  m.cov_board = m.R_board_antenna * cov_antenna * m.R_board_antenna.transpose();
+  m.cov_board = cov_silhouette
+                    ? *cov_silhouette
+                    : Mat3(m.R_board_antenna *
+                           bootstrap_covariance(m.region.cloud_board, model_prepared, T_antenna_board, options) *
+                           m.R_board_antenna.transpose());
+  if (rival_deg > 0.0) {
+    m.warnings.push_back(
+        fmt::format("the registration is ambiguous: the model turned {:.0f}° about its axis fits "
+                    "nearly as well; the azimuth's σ includes it",
+                    rival_deg));
+    const Vec3 axis = m.R_board_antenna.col(2);
+    m.cov_board += std::pow(deg2rad(rival_deg) / 2.0, 2) * axis * axis.transpose();
+  }
   m.model_board = transformed(model_cloud, T_antenna_board.inverse());
 }
 
@@ -162,6 +322,10 @@ AntennaRoi parse_roi(const std::string& text) {
 
 NonContactResult measure_non_contact(const Capture& capture, const NonContactSetup& setup,
                                      const NonContactOptions& options, Diagnostics& diagnostics) {
+  if (setup.models.size() > 1 && setup.models.size() != setup.rois.size())
+    throw InputError("--model", fmt::format("{} models for {} regions: give one model for all, or one per --roi in "
+                                            "the same order",
+                                            setup.models.size(), setup.rois.size()));
   NonContactResult result;
   std::vector<std::size_t> roi_shots;
   for (const auto& roi : setup.rois) roi_shots.push_back(roi_shot(capture, roi));
@@ -218,20 +382,21 @@ NonContactResult measure_non_contact(const Capture& capture, const NonContactSet
     photos.push_back({views[i].name, capture.shots[result.posed[i]].t, result.poses.R_camera_board[i],
                       result.poses.t_camera_board[i], result.poses.covariance[i].topLeftCorner<3, 3>()});
   result.board = board_world_attitude(photos, track, setup.camera_imu, options.board_world, diagnostics);
+  result.warnings.insert(result.warnings.end(), result.board.warnings.begin(), result.board.warnings.end());
   if (capture.site) result.site = geomag::site_field(geomag::MagneticModel::wmm2025(), *capture.site);
-
-  std::vector<Vec3> viewpoints;
-  for (std::size_t i = 0; i < views.size(); ++i)
-    viewpoints.push_back(camera_centre(result.poses.R_camera_board[i], result.poses.t_camera_board[i]));
-  const Vec3 up_board = result.board.R_world_board.transpose() * Vec3::UnitZ();
-  const Mat3 cov_poses = pose_rotation_covariance(result.poses);
-
-  PointCloud model_cloud;
-  std::optional<registration::PreparedCloud> model_prepared;
-  if (setup.model) {
-    model_cloud = model::sample_surface(setup.model->mesh_antenna, options.model_spacing_m, options.seed);
-    model_prepared = registration::prepare(model_cloud, options.registration.fine);
+  {
+    std::vector<double> shot_t;
+    for (const auto i : result.posed) shot_t.push_back(capture.shots[i].t + setup.camera_imu.time_offset_s);
+    for (auto& w : field_check(data, track, shot_t, result.site, options)) {
+      result.board.warnings.push_back(w);  // carried into every antenna's attitude
+      result.warnings.push_back(std::move(w));
+    }
   }
+
+  Scene scene{views, setup.intrinsics, {}, result.board.R_world_board.transpose() * Vec3::UnitZ()};
+  for (std::size_t i = 0; i < views.size(); ++i)
+    scene.viewpoints.push_back(camera_centre(result.poses.R_camera_board[i], result.poses.t_camera_board[i]));
+  const Mat3 cov_poses = pose_rotation_covariance(result.poses);
 
   for (std::size_t k = 0; k < setup.rois.size(); ++k) {
     AntennaMeasurement m;
@@ -250,10 +415,10 @@ NonContactResult measure_non_contact(const Capture& capture, const NonContactSet
           [&](const std::string& s, int d, int t) { report(options, name + ": " + s, d, t); });
       for (const auto& w : m.region.warnings) m.warnings.push_back(w);
       report(options, name + ": registration", 0, 1);
-      if (setup.model) {
-        register_model(m, *setup.model, model_cloud, *model_prepared, viewpoints, up_board, options);
+      if (const auto* model = setup.model_for(k)) {
+        register_model(m, *model, scene, options);
       } else {
-        const FaceFit fit = fit_front_face(m.region.cloud_board, viewpoints, up_board, options.model_free);
+        const FaceFit fit = fit_front_face(m.region.cloud_board, scene.viewpoints, scene.up_board, options.model_free);
         m.method = "model-free (front face + long axis)";
         m.R_board_antenna = fit.R_scene_antenna;
         m.p_board_antenna = fit.centre_scene;
@@ -285,7 +450,9 @@ nlohmann::json to_json(const NonContactResult& r) {
   j["board"] = {{"R_world_board", matrix_json(r.board.R_world_board)},
                 {"photos_used", r.board.used},
                 {"heading_scatter_deg", r.board.heading_scatter_deg},
-                {"view_spread_deg", r.board.view_spread_deg}};
+                {"view_spread_deg", r.board.view_spread_deg},
+                {"heading_sigma_deg", rad2deg(std::sqrt(r.board.covariance(2, 2)))},
+                {"tilt_sigma_deg", rad2deg(std::sqrt((r.board.covariance(0, 0) + r.board.covariance(1, 1)) / 2))}};
   j["world"] = "enu-magnetic";
   j["declination_deg"] = r.site ? nlohmann::json(rad2deg(r.site->declination)) : nlohmann::json(nullptr);
   j["warnings"] = r.warnings;
@@ -312,6 +479,7 @@ nlohmann::json to_json(const NonContactResult& r) {
     a["fit_rmse_m"] = ok ? nlohmann::json(m.fit_rmse_m) : nullptr;
     a["fitness"] = ok ? nlohmann::json(m.fitness) : nullptr;
     a["front_back_margin"] = m.front_back_margin ? nlohmann::json(*m.front_back_margin) : nullptr;
+    a["outline_rms_px"] = m.silhouette_rms_px ? nlohmann::json(*m.silhouette_rms_px) : nullptr;
     a["photos_used"] = m.region.views_used;
     a["points"] = m.region.cloud_board.size();
     a["reconstruction"] = m.region.method;

@@ -32,6 +32,7 @@
 #include "antpose/model/antenna_model.hpp"
 #include "antpose/reconstruction/reconstruct.hpp"
 #include "antpose/registration/global_start.hpp"
+#include "antpose/registration/silhouette.hpp"
 
 namespace antpose::measure {
 
@@ -48,8 +49,15 @@ struct NonContactSetup {
   camera::BoardSpec board;
   camera::CameraIntrinsics intrinsics;
   CameraImu camera_imu;
-  std::optional<model::AntennaModel> model;  // none: the model-free face fit
+  /// None: the model-free face fit; one: every antenna's; else one per ROI, in order.
+  std::vector<model::AntennaModel> models;
   std::vector<AntennaRoi> rois;
+
+  /// The model of ROI k, or nullptr (model-free).
+  const model::AntennaModel* model_for(std::size_t k) const {
+    if (models.empty()) return nullptr;
+    return &models[models.size() == 1 ? 0 : k];
+  }
 };
 
 struct NonContactOptions {
@@ -61,12 +69,44 @@ struct NonContactOptions {
     o.downtilt_deg = {-5.0, 5.0, 15.0};
     return o;
   }();
+  /// The outline stage: starts at the points' pose turned about the panel's axis by these
+  /// angles, each refined by the silhouette in every photo (registration/silhouette.hpp). A box's
+  /// outline is the same turned by 180°: front and back stay the points' decision (their
+  /// visibility check), so the starts stay within ±90° of it.
+  bool silhouette = true;
+  std::vector<double> silhouette_yaw_starts_deg = {0, 25, -25, 50, -50, 75, -75};
+  double silhouette_rival_margin = 0.02;  // a converged start within this score is a rival
+  /// The starts already span the yaws: the refinement's own mirror restarts are left out.
+  registration::SilhouetteOptions silhouette_options = [] {
+    registration::SilhouetteOptions o;
+    o.rival_yaw_offsets_rad.clear();
+    o.min_inlier_fraction = 0.35;  // a neighbouring panel or the mast may hide part of the outline
+    return o;
+  }();
   ModelFreeOptions model_free;
-  BoardWorldOptions board_world;
+  /// The antpose filter's covariance weights its corrections (a steady state near 2° tilt and 7°
+  /// heading) and is not a calibrated uncertainty, so the orientation error common to a capture
+  /// is modelled: heading 0.6°, tilt 0.1° per axis (the board attitude errors of the development
+  /// captures were 0.42° and 0.06° RMS, a calibrated typical phone; docs/non-contact.md).
+  BoardWorldOptions board_world = [] {
+    BoardWorldOptions o;
+    o.common_sigma_rad = Vec2(deg2rad(0.1), deg2rad(0.6));
+    return o;
+  }();
+  // The field at the photos against the Earth's: a calibrated magnetometer reads strength to
+  // about 1 % and dip to about 0.5°; a steel mast turning north by a few degrees moves them by
+  // more (contact mode, held still on the plate, uses 10 % and 5°).
+  double field_tolerance = 0.04;
+  double dip_tolerance = deg2rad(2.0);
+  double field_half_window_s = 0.25;
   double model_spacing_m = 0.01;  // model surface samples
   double warn_rmse_m = 0.015;     // fit RMSE above this: poor fit warning
   double fail_rmse_m = 0.05;      // or fitness below fail_fitness: the region does not hold the model
   double fail_fitness = 0.5;
+  double fail_fitness_with_outline = 0.2;  // when the outline matched the photos
+  double warn_fitness = 0.75;              // share of points near the model below this: warning
+  double rival_min_deg = 10.0;             // another hypothesis this far in boresight, scoring within the
+                                           // ambiguity margin, widens the azimuth σ to half the angle
   int bootstrap_replicas = 40;
   double bootstrap_block_m = 0.10;
   std::uint64_t seed = 1;
@@ -86,6 +126,7 @@ struct AntennaMeasurement {
   double fit_rmse_m = 0.0;
   double fitness = 0.0;                     // share of region points within reach of the model
   std::optional<double> front_back_margin;  // model registration only
+  std::optional<double> silhouette_rms_px;  // the outline's edge RMS, when it decided the pose
   reconstruction::RegionReconstruction region;
   PointCloud model_board;  // the registered model's samples, board frame (report)
   std::vector<std::string> warnings;
@@ -104,7 +145,7 @@ struct NonContactResult {
 
 /// The whole measurement. `capture` should already carry the device's IMU calibration
 /// (imu::apply). InputError for an ROI naming no photo of the capture or lying outside its
-/// image; MeasurementError when the board is found in fewer than two photos or the board's world
+/// image, or a number of models other than 0, 1 or one per ROI; MeasurementError when the board is found in fewer than two photos or the board's world
 /// attitude cannot be formed. A failure of one antenna is recorded in its `error`.
 NonContactResult measure_non_contact(const Capture& capture, const NonContactSetup& setup,
                                      const NonContactOptions& options, Diagnostics& diagnostics);

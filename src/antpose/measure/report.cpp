@@ -43,8 +43,8 @@ std::string html_escape(const std::string& s) {
 }
 
 // The antenna's box in its own frame: the model's size, or (model-free) the points' extent.
-std::pair<Vec3, Vec3> antenna_box(const AntennaMeasurement& m, const NonContactSetup& setup) {
-  if (setup.model) return {-setup.model->size_m / 2, setup.model->size_m / 2};
+std::pair<Vec3, Vec3> antenna_box(const AntennaMeasurement& m, const model::AntennaModel* model) {
+  if (model) return {-model->size_m / 2, model->size_m / 2};
   Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
   for (const auto& p : m.region.cloud_board.points) {
     const Vec3 q = m.R_board_antenna.transpose() * (p - m.p_board_antenna);
@@ -54,8 +54,8 @@ std::pair<Vec3, Vec3> antenna_box(const AntennaMeasurement& m, const NonContactS
 }
 
 void draw_overlay(cv::Mat& image, double scale, const camera::CameraIntrinsics& in, const Mat3& R_cb, const Vec3& t_cb,
-                  const AntennaMeasurement& m, const NonContactSetup& setup, int number) {
-  const auto [lo, hi] = antenna_box(m, setup);
+                  const AntennaMeasurement& m, const model::AntennaModel* model, int number) {
+  const auto [lo, hi] = antenna_box(m, model);
   auto px = [&](const Vec3& p_antenna) -> std::optional<cv::Point> {
     const Vec3 p_board = m.R_board_antenna * p_antenna + m.p_board_antenna;
     const auto uv = in.project(R_cb * p_board + t_cb);
@@ -240,7 +240,7 @@ void write_report(const fs::path& folder, const Capture& capture, const NonConta
         }
         if (!m.error)
           draw_overlay(image, scale, setup.intrinsics, result.poses.R_camera_board[i], result.poses.t_camera_board[i],
-                       m, setup, static_cast<int>(k + 1));
+                       m, setup.model_for(k), static_cast<int>(k + 1));
       }
       const auto name = fmt::format("overlay_{:02d}.jpg", i + 1);
       if (!cv::imwrite((tmp / name).string(), image, {cv::IMWRITE_JPEG_QUALITY, 88}))

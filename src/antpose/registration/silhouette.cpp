@@ -1,0 +1,575 @@
+#include "antpose/registration/silhouette.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <stdexcept>
+#include <tuple>
+
+#include <fmt/format.h>
+#include <opencv2/core/utility.hpp>
+#include <opencv2/imgproc.hpp>
+
+namespace antpose::registration {
+namespace {
+
+using Vec6 = Eigen::Matrix<double, 6, 1>;
+using Mat6 = Eigen::Matrix<double, 6, 6>;
+
+// The mesh welded by position (files and parametric panels may repeat vertices along creases),
+// with each edge's two triangles: contour generators are edges whose triangles face opposite ways.
+struct EdgeMesh {
+  std::vector<Vec3> vertices;
+  std::vector<std::array<std::uint32_t, 3>> triangles;
+  std::vector<Vec3> normals;  // by winding, not normalised
+  struct Edge {
+    std::uint32_t a, b;
+    std::vector<std::uint32_t> faces;
+  };
+  std::vector<Edge> edges;
+};
+
+EdgeMesh weld(const model::Mesh& mesh) {
+  EdgeMesh m;
+  std::map<std::tuple<long long, long long, long long>, std::uint32_t> index;
+  std::vector<std::uint32_t> remap(mesh.vertices.size());
+  for (std::size_t i = 0; i < mesh.vertices.size(); ++i) {
+    const Vec3& v = mesh.vertices[i];
+    const auto key = std::make_tuple(std::llround(v.x() * 1e7), std::llround(v.y() * 1e7), std::llround(v.z() * 1e7));
+    const auto [it, inserted] = index.emplace(key, static_cast<std::uint32_t>(m.vertices.size()));
+    if (inserted) m.vertices.push_back(v);
+    remap[i] = it->second;
+  }
+  std::map<std::pair<std::uint32_t, std::uint32_t>, std::size_t> edge_index;
+  for (const auto& t : mesh.triangles) {
+    const std::array<std::uint32_t, 3> w{remap.at(t[0]), remap.at(t[1]), remap.at(t[2])};
+    if (w[0] == w[1] || w[1] == w[2] || w[0] == w[2]) continue;
+    const auto f = static_cast<std::uint32_t>(m.triangles.size());
+    m.triangles.push_back(w);
+    m.normals.push_back((m.vertices[w[1]] - m.vertices[w[0]]).cross(m.vertices[w[2]] - m.vertices[w[0]]));
+    for (int k = 0; k < 3; ++k) {
+      const auto key = std::minmax(w[k], w[(k + 1) % 3]);
+      const auto [it, inserted] = edge_index.emplace(key, m.edges.size());
+      if (inserted) m.edges.push_back({key.first, key.second, {}});
+      m.edges[it->second].faces.push_back(f);
+    }
+  }
+  return m;
+}
+
+struct Pose {
+  Mat3 R = Mat3::Identity();  // R_board_antenna
+  Vec3 t = Vec3::Zero();      // p_board_antenna
+};
+
+// One photo cropped around the antenna: gradient images of a Gaussian pyramid.
+struct PreparedView {
+  bool usable = false;
+  Mat3 R_cb = Mat3::Identity();
+  Vec3 t_cb = Vec3::Zero();
+  Vec2 offset = Vec2::Zero();  // crop origin, full-resolution px
+  cv::Size size;
+  std::vector<cv::Mat> gx, gy;  // CV_32F per level
+};
+
+struct Sample {
+  Vec2 normal;                    // outward, image
+  double r = 0;                   // measured edge − projection along the normal, full-resolution px
+  Eigen::Matrix<double, 1, 6> J;  // d(projection · normal)/d(δ, δt)
+  std::uint32_t edge = 0;         // the mesh edge it lies on (correlated errors, see covariance)
+  double px_per_m = 0;            // f / depth: image size of a model shape error
+};
+
+float bilinear(const cv::Mat& m, double x, double y) {
+  const int x0 = static_cast<int>(std::floor(x)), y0 = static_cast<int>(std::floor(y));
+  if (x0 < 0 || y0 < 0 || x0 + 1 >= m.cols || y0 + 1 >= m.rows) return 0.f;
+  const float fx = static_cast<float>(x - x0), fy = static_cast<float>(y - y0);
+  const float* r0 = m.ptr<float>(y0);
+  const float* r1 = m.ptr<float>(y0 + 1);
+  return (1 - fy) * ((1 - fx) * r0[x0] + fx * r0[x0 + 1]) + fy * ((1 - fx) * r1[x0] + fx * r1[x0 + 1]);
+}
+
+std::optional<Vec2> project(const camera::CameraIntrinsics& K, const PreparedView& v, const Vec3& p_board) {
+  const Vec3 c = v.R_cb * p_board + v.t_cb;
+  if (c.z() <= 1e-3) return std::nullopt;
+  return K.project(c);
+}
+
+// Bounding box (full-resolution px) of the projected vertices; nullopt when one is behind the camera.
+std::optional<cv::Rect2d> projected_box(const camera::CameraIntrinsics& K, const PreparedView& v, const EdgeMesh& m,
+                                        const Pose& pose) {
+  double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300;
+  for (const auto& p : m.vertices) {
+    const auto uv = project(K, v, pose.R * p + pose.t);
+    if (!uv) return std::nullopt;
+    x0 = std::min(x0, uv->x()), y0 = std::min(y0, uv->y()), x1 = std::max(x1, uv->x()), y1 = std::max(y1, uv->y());
+  }
+  return cv::Rect2d(x0, y0, x1 - x0, y1 - y0);
+}
+
+// The outer contour samples of one view at `level` with their edge measurements.
+void gather(const EdgeMesh& m, const Pose& pose, const PreparedView& v, const camera::CameraIntrinsics& K, int level,
+            double search_px, const SilhouetteOptions& o, std::vector<Sample>& out, std::size_t& candidates,
+            std::size_t& outside) {
+  candidates = outside = 0;
+  if (!v.usable) return;
+  const double scale = std::ldexp(1.0, level);
+  // Camera centre in the antenna frame decides which faces look at the camera.
+  const Vec3 centre_board = -v.R_cb.transpose() * v.t_cb;
+  const Vec3 centre_antenna = pose.R.transpose() * (centre_board - pose.t);
+  std::vector<char> front(m.triangles.size());
+  for (std::size_t f = 0; f < m.triangles.size(); ++f)
+    front[f] = m.normals[f].dot(centre_antenna - m.vertices[m.triangles[f][0]]) > 0;
+
+  // Mask of the projection (front faces cover it for a closed mesh), edges subdivided so that the
+  // distortion's bowing is kept; over the projection's own box (so that the outer-contour test
+  // also works outside the crop, where samples are counted as unmeasurable), at most ~1000 px.
+  std::vector<std::optional<Vec2>> uv(m.vertices.size());
+  Vec2 lo = Vec2::Constant(1e300), hi = Vec2::Constant(-1e300);
+  for (std::size_t i = 0; i < m.vertices.size(); ++i) {
+    uv[i] = project(K, v, pose.R * m.vertices[i] + pose.t);
+    if (!uv[i]) return;  // part of the model behind the camera
+    lo = lo.cwiseMin(*uv[i]), hi = hi.cwiseMax(*uv[i]);
+  }
+  const double pad = 8 + 0.05 * (hi - lo).maxCoeff();
+  const Vec2 origin = lo - Vec2::Constant(pad);
+  const Vec2 extent = hi - lo + Vec2::Constant(2 * pad);
+  if (!(extent.maxCoeff() < 1e5)) return;  // a degenerate projection (model at the camera)
+  const double ms = std::max(1.0, extent.maxCoeff() / 1000.0);
+  cv::Mat mask = cv::Mat::zeros(static_cast<int>(std::ceil(extent.y() / ms)) + 1,
+                                static_cast<int>(std::ceil(extent.x() / ms)) + 1, CV_8UC1);
+  auto to_mask = [&](const Vec2& p) { return Vec2((p.x() - origin.x()) / ms, (p.y() - origin.y()) / ms); };
+  for (std::size_t f = 0; f < m.triangles.size(); ++f) {
+    const auto& t = m.triangles[f];
+    std::vector<cv::Point> poly;
+    for (int k = 0; k < 3; ++k) {
+      const Vec3 A = pose.R * m.vertices[t[k]] + pose.t, B = pose.R * m.vertices[t[(k + 1) % 3]] + pose.t;
+      const double len = (*uv[t[(k + 1) % 3]] - *uv[t[k]]).norm() / ms;
+      const int n = std::clamp(static_cast<int>(std::ceil(len / 8.0)), 1, 64);
+      for (int j = 0; j < n; ++j) {
+        const auto p = project(K, v, A + (B - A) * (double(j) / n));
+        if (!p) return;
+        const Vec2 q = to_mask(*p) * 4.0;  // shift = 2: quarter-pixel vertices
+        poly.emplace_back(static_cast<int>(std::lround(q.x())), static_cast<int>(std::lround(q.y())));
+      }
+    }
+    cv::fillPoly(mask, std::vector<std::vector<cv::Point>>{poly}, cv::Scalar(255), cv::LINE_8, 2);
+  }
+  auto inside = [&](const Vec2& q) {
+    const int x = static_cast<int>(std::lround(q.x())), y = static_cast<int>(std::lround(q.y()));
+    return x >= 0 && y >= 0 && x < mask.cols && y < mask.rows && mask.at<std::uint8_t>(y, x) != 0;
+  };
+
+  const cv::Mat& gx = v.gx[level];
+  const cv::Mat& gy = v.gy[level];
+  const double step = 0.5;
+  const int half = static_cast<int>(std::ceil(search_px / step));
+  std::vector<double> g(2 * half + 1);
+  const double spacing = o.sample_spacing_px * scale;
+  for (std::size_t ei = 0; ei < m.edges.size(); ++ei) {
+    const auto& e = m.edges[ei];
+    bool silhouette = e.faces.size() == 1;
+    for (std::size_t i = 1; i < e.faces.size(); ++i) silhouette |= front[e.faces[i]] != front[e.faces[0]];
+    if (!silhouette) continue;
+    const Vec2 pa = *uv[e.a], pb = *uv[e.b];
+    const int n = static_cast<int>(std::floor((pb - pa).norm() / spacing));
+    const Vec3 A = pose.R * m.vertices[e.a] + pose.t, B = pose.R * m.vertices[e.b] + pose.t;
+    for (int j = 0; j < n; ++j) {
+      const double s = (j + 0.5) / n, ds = 0.25 / n;
+      const Vec3 X = A + (B - A) * s;
+      const auto p = project(K, v, X);
+      const auto p0 = project(K, v, A + (B - A) * (s - ds));
+      const auto p1 = project(K, v, A + (B - A) * (s + ds));
+      if (!p || !p0 || !p1) continue;
+      const Vec2 d = (*p1 - *p0).normalized();
+      Vec2 normal(-d.y(), d.x());
+      const Vec2 q = to_mask(*p);
+      const double k = 1.5;
+      const bool in_minus = inside(q - k * normal), in_plus = inside(q + k * normal);
+      if (in_minus == in_plus) continue;  // inner edge, or hidden by another part of the model
+      if (in_plus) normal = -normal;
+      ++candidates;
+      const Vec2 in_crop = *p - v.offset;
+      if (in_crop.x() < 0 || in_crop.y() < 0 || in_crop.x() > v.size.width - 1 || in_crop.y() > v.size.height - 1) {
+        ++outside;
+        continue;
+      }
+      // 1-D search along the normal for the nearest strong edge (Drummond & Cipolla 2002).
+      const Vec2 c = (*p - v.offset) / scale;
+      double gmax = 0;
+      for (int i = -half; i <= half; ++i) {
+        const Vec2 z = c + (i * step) * normal;
+        g[i + half] = std::abs(bilinear(gx, z.x(), z.y()) * normal.x() + bilinear(gy, z.x(), z.y()) * normal.y());
+        gmax = std::max(gmax, g[i + half]);
+      }
+      if (gmax < o.min_edge_gradient) continue;
+      int best = -1;
+      for (int i = 1; i + 1 < static_cast<int>(g.size()); ++i) {
+        if (g[i] < 0.5 * gmax || g[i] < o.min_edge_gradient || g[i] < g[i - 1] || g[i] < g[i + 1]) continue;
+        if (best < 0 || std::abs(i - half) < std::abs(best - half)) best = i;
+      }
+      if (best < 0) continue;
+      const double den = g[best - 1] - 2 * g[best] + g[best + 1];
+      const double sub = den < 0 ? std::clamp(0.5 * (g[best - 1] - g[best + 1]) / den, -0.5, 0.5) : 0.0;
+      Sample smp;
+      smp.normal = normal;
+      smp.r = ((best - half) + sub) * step * scale;
+      // Jacobian of the projection by central differences in the camera frame (distortion included).
+      const Vec3 Xc = v.R_cb * X + v.t_cb;
+      Eigen::Matrix<double, 2, 3> dp;
+      const double h = 1e-6 * Xc.z();
+      bool ok = true;
+      for (int a = 0; a < 3 && ok; ++a) {
+        Vec3 dx = Vec3::Zero();
+        dx[a] = h;
+        const auto pp = K.project(Xc + dx), pm = K.project(Xc - dx);
+        if (!pp || !pm)
+          ok = false;
+        else
+          dp.col(a) = (*pp - *pm) / (2 * h);
+      }
+      if (!ok) continue;
+      Eigen::Matrix<double, 3, 6> dX;
+      dX.leftCols<3>() = -skew(X - pose.t);
+      dX.rightCols<3>() = Mat3::Identity();
+      smp.J = normal.transpose() * dp * v.R_cb * dX;
+      smp.edge = static_cast<std::uint32_t>(ei);
+      smp.px_per_m = 0.5 * (K.fx + K.fy) / Xc.z();
+      out.push_back(smp);
+    }
+  }
+}
+
+struct Gathered {
+  std::vector<std::vector<Sample>> per_view;
+  std::size_t candidates = 0, outside = 0, views_with_samples = 0;
+};
+
+Gathered gather_all(const EdgeMesh& m, const Pose& pose, const std::vector<PreparedView>& views,
+                    const camera::CameraIntrinsics& K, int level, double search_px, const SilhouetteOptions& o) {
+  Gathered g;
+  g.per_view.resize(views.size());
+  std::vector<std::size_t> candidates(views.size(), 0), outside(views.size(), 0);
+  cv::parallel_for_(cv::Range(0, static_cast<int>(views.size())), [&](const cv::Range& r) {
+    for (int i = r.start; i < r.end; ++i)
+      gather(m, pose, views[i], K, level, search_px, o, g.per_view[i], candidates[i], outside[i]);
+  });
+  for (std::size_t i = 0; i < views.size(); ++i) {
+    g.candidates += candidates[i];
+    g.outside += outside[i];
+    g.views_with_samples += g.per_view[i].empty() ? 0 : 1;
+  }
+  return g;
+}
+
+// Tukey weights with the scale from the median absolute residual (in the level's px).
+struct Normal {
+  Mat6 H = Mat6::Zero();
+  Vec6 b = Vec6::Zero();
+  double sum_w = 0, sum_wr2 = 0;
+  std::size_t inliers = 0, samples = 0;
+  double c = 0;  // Tukey's cut-off, full-resolution px
+  double weight(double r) const {
+    if (!(std::abs(r) < c)) return 0.0;
+    const double u = r / c;
+    return (1 - u * u) * (1 - u * u);
+  }
+};
+
+Normal normal_equations(const Gathered& g, double scale, const SilhouetteOptions& o) {
+  Normal n;
+  std::vector<double> abs_r;
+  for (const auto& v : g.per_view)
+    for (const auto& s : v) abs_r.push_back(std::abs(s.r) / scale);
+  n.samples = abs_r.size();
+  if (abs_r.empty()) return n;
+  std::nth_element(abs_r.begin(), abs_r.begin() + abs_r.size() / 2, abs_r.end());
+  const double sigma = std::max(0.5, 1.4826 * abs_r[abs_r.size() / 2]);
+  n.c = o.tukey_c * sigma * scale;
+  for (const auto& v : g.per_view)
+    for (const auto& s : v) {
+      const double w = n.weight(s.r);
+      if (w <= 0) continue;
+      n.H += w * s.J.transpose() * s.J;
+      n.b += w * s.J.transpose() * s.r;
+      n.sum_w += w;
+      n.sum_wr2 += w * s.r * s.r;
+      ++n.inliers;
+    }
+  return n;
+}
+
+// Solves the damped normal equations over the free DOF; nullopt when they are singular.
+std::optional<Vec6> solve(const Normal& n, const std::array<bool, 6>& free, Mat6* inverse = nullptr) {
+  std::vector<int> idx;
+  for (int i = 0; i < 6; ++i)
+    if (free[i]) idx.push_back(i);
+  const int k = static_cast<int>(idx.size());
+  Eigen::MatrixXd H(k, k);
+  Eigen::VectorXd b(k);
+  for (int i = 0; i < k; ++i) {
+    b[i] = n.b[idx[i]];
+    for (int j = 0; j < k; ++j) H(i, j) = n.H(idx[i], idx[j]);
+  }
+  Eigen::LDLT<Eigen::MatrixXd> ldlt(H);
+  if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 1e-12 * std::max(1.0, H.diagonal().maxCoeff())))
+    return std::nullopt;
+  Eigen::MatrixXd Hd = H;
+  Hd.diagonal() *= 1.0 + 1e-6;  // a touch of Levenberg–Marquardt damping
+  const Eigen::VectorXd x = Hd.ldlt().solve(b);
+  Vec6 delta = Vec6::Zero();
+  for (int i = 0; i < k; ++i) delta[idx[i]] = x[i];
+  if (inverse) {
+    const Eigen::MatrixXd Hi = ldlt.solve(Eigen::MatrixXd::Identity(k, k));
+    inverse->setZero();
+    for (int i = 0; i < k; ++i)
+      for (int j = 0; j < k; ++j) (*inverse)(idx[i], idx[j]) = Hi(i, j);
+  }
+  if (!delta.allFinite()) return std::nullopt;
+  return delta;
+}
+
+// Mean truncated quadratic cost of the outline at full resolution, in [0, 1]: 0 when every
+// contour sample lies on an edge, 1 per sample without an edge within score_cutoff_px (fixed, so
+// that poses compare; chamfer-like, Barrow et al. 1977).
+double score(const Gathered& g, const SilhouetteOptions& o) {
+  if (g.candidates == 0) return 1.0;
+  double sum = 0;
+  std::size_t found = 0;
+  for (const auto& v : g.per_view)
+    for (const auto& s : v) {
+      sum += std::min(1.0, (s.r * s.r) / (o.score_cutoff_px * o.score_cutoff_px));
+      ++found;
+    }
+  return (sum + double(g.candidates - found)) / double(g.candidates);
+}
+
+struct Descent {
+  Pose pose;
+  bool converged = false;
+  int iterations = 0;
+  double score = 1.0;
+};
+
+}  // namespace
+
+SilhouetteResult refine_by_silhouette(const model::Mesh& mesh_antenna, const Iso3& T_board_antenna_initial,
+                                      const std::vector<SilhouetteView>& views,
+                                      const camera::CameraIntrinsics& intrinsics, const SilhouetteOptions& options) {
+  if (mesh_antenna.triangles.empty()) throw std::invalid_argument("refine_by_silhouette: the mesh has no triangles");
+  const EdgeMesh m = weld(mesh_antenna);
+  SilhouetteResult result;
+  result.T_board_antenna = T_board_antenna_initial;
+  Pose pose{T_board_antenna_initial.linear(), T_board_antenna_initial.translation()};
+  const Pose start = pose;
+
+  // Crops and the coarsest level: the model's narrowest projection stays min_coarse_width_px wide.
+  std::vector<PreparedView> prepared(views.size());
+  double narrowest = 1e300;
+  for (std::size_t i = 0; i < views.size(); ++i) {
+    const auto& in = views[i];
+    if (in.image.type() != CV_8UC1 || in.image.cols != intrinsics.width || in.image.rows != intrinsics.height)
+      throw std::invalid_argument(fmt::format("refine_by_silhouette: view {} is not a CV_8UC1 image of {}x{} px", i,
+                                              intrinsics.width, intrinsics.height));
+    auto& v = prepared[i];
+    v.R_cb = in.R_camera_board;
+    v.t_cb = in.t_camera_board;
+    const auto box = projected_box(intrinsics, v, m, pose);
+    if (!box) {
+      result.warnings.push_back(fmt::format("view {}: the model lies (partly) behind the camera; skipped", i));
+      continue;
+    }
+    cv::Rect crop;
+    if (in.roi) {
+      crop = *in.roi;
+    } else {
+      const double margin = options.roi_margin_px + 0.1 * std::max(box->width, box->height);
+      crop = cv::Rect(static_cast<int>(std::floor(box->x - margin)), static_cast<int>(std::floor(box->y - margin)),
+                      static_cast<int>(std::ceil(box->width + 2 * margin)),
+                      static_cast<int>(std::ceil(box->height + 2 * margin)));
+    }
+    crop &= cv::Rect(0, 0, in.image.cols, in.image.rows);
+    if (crop.width < 16 || crop.height < 16) {
+      result.warnings.push_back(fmt::format("view {}: the antenna's region lies outside the photo; skipped", i));
+      continue;
+    }
+    v.usable = true;
+    v.offset = Vec2(crop.x, crop.y);
+    v.size = crop.size();
+    narrowest = std::min(narrowest, std::min(box->width, box->height));
+  }
+  int top = 0;
+  if (narrowest < 1e300)
+    top = std::clamp(static_cast<int>(std::floor(std::log2(std::max(1.0, narrowest / options.min_coarse_width_px)))), 0,
+                     std::max(0, options.max_level));
+  cv::parallel_for_(cv::Range(0, static_cast<int>(views.size())), [&](const cv::Range& r) {
+    for (int i = r.start; i < r.end; ++i) {
+      auto& v = prepared[i];
+      if (!v.usable) continue;
+      const cv::Mat crop = views[i].image(
+          cv::Rect(static_cast<int>(v.offset.x()), static_cast<int>(v.offset.y()), v.size.width, v.size.height));
+      // Edges are located in linear intensity: a gamma-encoded blurred step has its steepest point
+      // shifted towards the dark side, which would bias the outline's width and so the yaw.
+      cv::Mat level;
+      if (options.gamma > 0) {
+        cv::Mat lut(1, 256, CV_32F);
+        for (int k = 0; k < 256; ++k) lut.at<float>(k) = static_cast<float>(255.0 * std::pow(k / 255.0, options.gamma));
+        cv::LUT(crop, lut, level);
+      } else {
+        crop.convertTo(level, CV_32F);
+      }
+      for (int l = 0; l <= top; ++l) {
+        if (l > 0) {
+          cv::Mat down;
+          cv::pyrDown(level, down);
+          level = down;
+        }
+        cv::Mat f, gx, gy;
+        cv::GaussianBlur(level, f, cv::Size(), options.smoothing_sigma_px);
+        cv::Sobel(f, gx, CV_32F, 1, 0, 3, 1.0 / 8.0);
+        cv::Sobel(f, gy, CV_32F, 0, 1, 3, 1.0 / 8.0);
+        v.gx.push_back(gx);
+        v.gy.push_back(gy);
+      }
+    }
+  });
+
+  const auto descend = [&](Pose p) {
+    Descent d;
+    d.pose = p;
+    for (int level = top; level >= 0; --level) {
+      const double scale = std::ldexp(1.0, level);
+      const double search =
+          level == top ? std::max(options.fine_search_px, options.search_range_px / scale) : options.fine_search_px;
+      d.converged = false;
+      for (int it = 0; it < options.max_iterations_per_level; ++it) {
+        const Gathered g = gather_all(m, d.pose, prepared, intrinsics, level, search, options);
+        const Normal n = normal_equations(g, scale, options);
+        if (n.inliers < 12) break;
+        const auto delta = solve(n, options.free);
+        if (!delta) break;
+        ++d.iterations;
+        d.pose.R = exp_so3(delta->head<3>()) * d.pose.R;
+        d.pose.t += delta->tail<3>();
+        // The step's weighted RMS image motion, in the level's px.
+        const double motion = std::sqrt(std::max(0.0, delta->dot(n.H * *delta)) / n.sum_w) / scale;
+        if (motion < 0.01) {
+          d.converged = true;
+          break;
+        }
+      }
+    }
+    d.score = score(gather_all(m, d.pose, prepared, intrinsics, 0, options.fine_search_px, options), options);
+    return d;
+  };
+
+  Descent best = descend(pose);
+  result.iterations = best.iterations;
+  // A panel's outline is nearly the same at two yaws (the width w|cos θ| + d|sin θ| repeats
+  // about θ = atan(d/w)) when the views span little: descend again from starts turned about the
+  // long axis and keep the best score; a distinct rival that scores nearly as well is reported.
+  std::optional<Descent> rival;
+  for (const double offset : options.rival_yaw_offsets_rad) {
+    const Vec3 axis = best.pose.R.col(2);
+    Descent d = descend(Pose{exp_so3(offset * axis) * best.pose.R, best.pose.t});
+    result.iterations += d.iterations;
+    if (rotation_distance(d.pose.R, best.pose.R) < deg2rad(2.0)) continue;
+    if (d.score < best.score && rotation_distance(d.pose.R, start.R) <= options.max_rotation_change_rad)
+      std::swap(d, best);
+    if (!rival || d.score < rival->score) rival = d;
+  }
+  pose = best.pose;
+  const bool last_level_converged = best.converged;
+  result.score = best.score;
+  if (rival) {
+    result.rival_score = rival->score;
+    result.rival_rotation_rad = rotation_distance(rival->pose.R, best.pose.R);
+  }
+
+  // Statistics and covariance at the solution (full resolution, fine search).
+  const Gathered g = gather_all(m, pose, prepared, intrinsics, 0, options.fine_search_px, options);
+  const Normal n = normal_equations(g, 1.0, options);
+  result.T_board_antenna.linear() = pose.R;
+  result.T_board_antenna.translation() = pose.t;
+  result.views_used = g.views_with_samples;
+  result.samples = n.inliers;
+  result.inlier_fraction = g.candidates ? double(n.inliers) / double(g.candidates) : 0.0;
+  Mat6 Hinv;
+  const bool solvable = n.inliers > 12 && solve(n, options.free, &Hinv).has_value();
+  if (solvable) {
+    result.rms_px = std::sqrt(n.sum_wr2 / n.sum_w);
+    const double dof = std::max(1.0, n.sum_w - 6.0);
+    const double sigma2 = n.sum_wr2 / dof;
+    const double inflation = std::max(1.0, options.correlation_length_px / options.sample_spacing_px);
+    // Sandwich H⁻¹ (Σ_white + Σ_bias) H⁻¹: white edge noise (inflated for the samples' overlap),
+    // plus errors shared by all samples of a mesh edge: the model's shape tolerance (the same in
+    // every view) and an edge-localisation bias per view and edge (background, blur, shading).
+    Mat6 M = sigma2 * inflation * n.H;
+    std::vector<Vec6> shape(m.edges.size(), Vec6::Zero()), bias(m.edges.size(), Vec6::Zero());
+    for (const auto& view : g.per_view)
+      for (const auto& s : view) {
+        const double w = n.weight(s.r);
+        if (w <= 0) continue;
+        shape[s.edge] += w * s.px_per_m * options.shape_tolerance_m * s.J.transpose();
+        bias[s.edge] += w * options.edge_bias_px * s.J.transpose();
+      }
+    for (std::size_t e = 0; e < m.edges.size(); ++e)
+      M += shape[e] * shape[e].transpose() + bias[e] * bias[e].transpose();
+    result.covariance = Hinv * M * Hinv;
+  }
+
+  bool ok = solvable && last_level_converged;
+  if (!solvable)
+    result.warnings.push_back("silhouette: too few contour samples found an edge to fix the pose");
+  else if (!last_level_converged)
+    result.warnings.push_back(fmt::format("silhouette: no convergence within {} iterations at full resolution",
+                                          options.max_iterations_per_level));
+  const double outside = g.candidates ? double(g.outside) / double(g.candidates) : 0.0;
+  if (outside > options.max_outside_fraction) {
+    ok = false;
+    result.warnings.push_back(
+        fmt::format("silhouette: {:.0f} % of the model's outline falls outside the photos or their regions of interest",
+                    100 * outside));
+  }
+  if (static_cast<int>(result.views_used) < options.min_views) {
+    ok = false;
+    result.warnings.push_back(fmt::format("silhouette: only {} view(s) show the model's outline (at least {} needed)",
+                                          result.views_used, options.min_views));
+  }
+  if (result.inlier_fraction < options.min_inlier_fraction) {
+    ok = false;
+    result.warnings.push_back(fmt::format(
+        "silhouette: only {:.0f} % of the model's outline meets an image edge (at least {:.0f} % expected); is the "
+        "antenna in the photos and the start close?",
+        100 * result.inlier_fraction, 100 * options.min_inlier_fraction));
+  }
+  if (solvable && result.rms_px > options.max_rms_px) {
+    ok = false;
+    result.warnings.push_back(
+        fmt::format("silhouette: edge RMS {:.2f} px (more than {:.2f} px)", result.rms_px, options.max_rms_px));
+  }
+  if (rival && rival->score < best.score) {
+    ok = false;
+    result.warnings.push_back(fmt::format(
+        "silhouette: a pose turned {:.1f}° from the result fits the outline better (score {:.3f} vs {:.3f}) but lies "
+        "more than {:.0f}° from the start: the start is probably wrong",
+        rad2deg(result.rival_rotation_rad), rival->score, best.score, rad2deg(options.max_rotation_change_rad)));
+  } else if (rival && rival->score < best.score + options.rival_margin) {
+    ok = false;
+    result.warnings.push_back(fmt::format(
+        "silhouette: ambiguous yaw: a pose turned {:.1f}° fits the outline nearly as well (score {:.3f} vs {:.3f}); "
+        "photograph the antenna over a wider arc",
+        rad2deg(result.rival_rotation_rad), rival->score, best.score));
+  }
+  const double turned = rotation_distance(start.R, pose.R);
+  if (turned > options.max_rotation_change_rad) {
+    ok = false;
+    result.warnings.push_back(fmt::format(
+        "silhouette: the pose turned {:.1f}° from the start (more than {:.1f}°): probably another local minimum",
+        rad2deg(turned), rad2deg(options.max_rotation_change_rad)));
+  }
+  result.converged = ok;
+  return result;
+}
+
+}  // namespace antpose::registration

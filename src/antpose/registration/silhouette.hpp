@@ -1,0 +1,109 @@
+// Pose refinement of an antenna model by its silhouette in the photos.
+//
+// Dense stereo barely reconstructs a panel's flat, texture-free radome, so ICP fixes the long
+// axis well but the yaw about it poorly. The panel's OUTLINE, however, is sharp in every photo,
+// and its apparent width (w|cos θ| + d|sin θ| for a box seen at angle θ) changes with yaw over
+// views spanning 25–40°. This refines the 6-DOF pose so that the model's outer silhouette meets
+// the image edges in all views.
+//
+// Method: model-based edge tracking (Harris, "Tracking with rigid models", Active Vision 1992;
+// Drummond & Cipolla, "Real-time visual tracking of complex structures", PAMI 24(7), 2002).
+// For the current pose, per view: the mesh's contour generators (edges between a triangle facing
+// the camera and one facing away) are projected with the distorted camera model; only points on
+// the OUTER contour are kept (a rasterised mask must be filled just inside and empty just
+// outside: inner shading edges and parts hidden by the brackets are not geometry). Along each
+// sample's normal a 1-D search finds the nearest strong edge (gradient along the normal, a local
+// maximum of its magnitude, ≥ half the strongest on the line; sub-pixel by a parabola); the
+// residual is the signed distance. Gauss–Newton with Tukey's biweight (scale from the MAD) solves
+// for the pose; silhouettes are re-extracted every iteration. A Gaussian pyramid (cv::pyrDown)
+// runs coarse-to-fine: wide searches on blurred images first (inner shading gone), ±4 px last.
+// Scene edges not in the model (clamp arms, mast, board) are down-weighted by the robust loss.
+// Edges are searched in linear intensity (the photo's gamma undone): in encoded values a blurred
+// step's steepest point moves towards its dark side, biasing the outline's width and so the yaw.
+//
+// A box's outline repeats about θ = atan(d/w), so with a narrow arc of views a mirror yaw 30–50°
+// away fits nearly as well: descents restarted from the solution turned ±30° about the long axis
+// find it; the best score within max_rotation_change_rad of the start wins and a rival scoring
+// nearly as well (rival_margin) or better is reported (converged = false, a warning).
+//
+// Covariance (at the solution, H = Jᵀ W J): H⁻¹ (κ σ² H + Σ_g b_g b_gᵀ) H⁻¹. σ² is the weighted
+// residual variance, κ = correlation_length_px / sample_spacing_px because neighbouring samples
+// share the blur and JPEG blocks. The sum models errors common to all samples of a mesh edge,
+// which do not average out along it nor over the views: b_g = Σ_{i∈g} w_i J_iᵀ s_i over all views,
+// once with s_i = f · shape_tolerance_m / depth (the model's shape error) and once with
+// s_i = edge_bias_px (edge localisation biased by the shading of rounded edges near the outline and
+// by the background, both similar from view to view under one sun).
+#pragma once
+
+#include <array>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "antpose/camera/camera_model.hpp"
+#include "antpose/geometry/point_cloud.hpp"
+#include "antpose/model/mesh.hpp"
+
+namespace antpose::registration {
+
+struct SilhouetteView {
+  cv::Mat image;  // CV_8UC1 grey photo as taken (distorted), full size
+  Mat3 R_camera_board = Mat3::Identity();
+  Vec3 t_camera_board = Vec3::Zero();  // p_camera = R p_board + t (refined camera pose)
+  /// Crop (px) holding the antenna's whole outline plus the search range; else the start's
+  /// projected bounding box + margin (the normal choice).
+  std::optional<cv::Rect> roi;
+};
+
+struct SilhouetteOptions {
+  double search_range_px = 40;        // ± along the normal at the coarsest level (full-resolution px)
+  double fine_search_px = 4;          // ± at every later level (in that level's px)
+  double sample_spacing_px = 3;       // along the contour, at full resolution (× 2^level on coarser levels)
+  double min_edge_gradient = 3;       // linear grey levels (0–255) / px after smoothing; weaker: no sample
+  double smoothing_sigma_px = 1.0;    // Gaussian before the gradient, per level
+  double gamma = 2.2;                 // photo encoding undone before edge search (sRGB ≈ 2.2); 0: as stored
+  int max_level = 3;                  // coarsest pyramid level allowed
+  double min_coarse_width_px = 16;    // the coarsest level keeps the model's projection this wide
+  int max_iterations_per_level = 12;  // Gauss–Newton steps per level and descent
+  double tukey_c = 4.685;             // × robust σ (MAD), σ ≥ 0.5 px of the level
+  double roi_margin_px = 40;          // around the projected model (plus 10 % of its size)
+  double correlation_length_px = 12;  // covariance inflation (see the file comment)
+  double shape_tolerance_m = 0.001;   // model vs real panel, per mesh edge (covariance)
+  double edge_bias_px = 0.1;          // edge-localisation bias per mesh edge, all views (covariance)
+  std::array<bool, 6> free{true, true, true, true, true, true};  // rotation δ x, y, z (board), translation x, y, z
+  // Rivals: descents from the solution turned by these angles about the long axis (file comment).
+  std::vector<double> rival_yaw_offsets_rad{deg2rad(-30.0), deg2rad(30.0)};  // empty: none
+  double score_cutoff_px = 2.0;  // truncation of the score's squared distance (full resolution)
+  double rival_margin = 0.02;    // a distinct rival within this score of the best: ambiguous
+  // Acceptance: otherwise converged = false with a warning.
+  double min_inlier_fraction = 0.5;                // contour samples that found an edge with weight > 0
+  double max_outside_fraction = 0.05;              // contour samples outside the crops (ROI or photo)
+  double max_rms_px = 2.5;                         // at full resolution
+  double max_rotation_change_rad = deg2rad(15.0);  // 15° from the start: beyond, a different local minimum
+  int min_views = 2;
+};
+
+struct SilhouetteResult {
+  Iso3 T_board_antenna = Iso3::Identity();  // refined; p_board = T p_antenna
+  /// (rotation vector δ in the board frame, R_true = exp(δ) R_est; translation, m).
+  Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();
+  double rms_px = 0;  // weighted edge-distance RMS of the samples used, full resolution
+  double inlier_fraction = 0;
+  double score = 1;  // mean truncated cost of the outline, 0 (perfect) .. 1 (no edge found)
+  double rival_score = 1, rival_rotation_rad = 0;  // best distinct rival minimum, if any
+  std::size_t views_used = 0, samples = 0;
+  int iterations = 0;  // Gauss–Newton steps over all descents (start and rivals)
+  bool converged = false;
+  std::vector<std::string> warnings;
+};
+
+/// Refines T_board_antenna_initial (see the file comment). Views whose crop is empty or whose
+/// model projection falls behind the camera are skipped with a warning. std::invalid_argument
+/// for a mesh without triangles or an image that is not CV_8UC1 of the intrinsics' size.
+SilhouetteResult refine_by_silhouette(const model::Mesh& mesh_antenna, const Iso3& T_board_antenna_initial,
+                                      const std::vector<SilhouetteView>& views,
+                                      const camera::CameraIntrinsics& intrinsics, const SilhouetteOptions& options);
+
+}  // namespace antpose::registration

@@ -1,0 +1,166 @@
+// antpose measure on bad input: every case names what is wrong and never prints a confident
+// number it cannot support. One small simulated antenna capture serves all cases; the device
+// profile is the simulator's truth (these tests check messages, not accuracy: that is the long
+// acceptance test's job).
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <fmt/format.h>
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <yaml-cpp/yaml.h>
+
+#include "antpose/io/text_file.hpp"
+#include "antpose/model/antenna_model.hpp"
+#include "support/test_support.hpp"
+
+namespace antpose {
+namespace {
+
+namespace fs = std::filesystem;
+using ::testing::HasSubstr;
+
+class MeasureCli : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new test::TempDir;
+    const auto r = test::run_cli(fmt::format(
+        "simulate capture -o '{}' --scenario antenna --seed 3 --setting rooftop --photos 6 --width 960 --height 720",
+        capture().string()));
+    ASSERT_EQ(r.status, 0) << r.err;
+    // A device profile from the simulator's truth.
+    const YAML::Node truth = YAML::LoadFile((capture() / "truth/device.yaml").string());
+    YAML::Node profile;
+    profile["format"] = "antpose-device";
+    profile["version"] = 1;
+    profile["device"]["id"] = "sim";
+    profile["camera"] = truth["camera"];
+    profile["camera_imu"]["R_device_camera"] = truth["camera_imu"]["R_device_camera"];
+    profile["camera_imu"]["time_offset_s"] = truth["camera_imu"]["time_offset_s"];
+    YAML::Emitter out;
+    out << profile;
+    test::write_file(device(), out.c_str());
+    const YAML::Node scene = YAML::LoadFile((capture() / "truth/scene.yaml").string());
+    const auto roi = scene["antennas"][0]["roi"];
+    roi_image_ = roi["image"].as<std::string>();
+    roi_ = fmt::format("{}:{},{},{},{}", roi_image_, roi["x"].as<int>(), roi["y"].as<int>(), roi["width"].as<int>(),
+                       roi["height"].as<int>());
+    model_ = scene["antennas"][0]["model"].as<std::string>();
+  }
+  static void TearDownTestSuite() { delete dir_; }
+
+  static fs::path capture() { return *dir_ / "site"; }
+  static fs::path device() { return *dir_ / "phone.yaml"; }
+  static std::string measure(const fs::path& cap, const std::string& rest) {
+    return fmt::format("measure '{}' --device '{}' {}", cap.string(), device().string(), rest);
+  }
+  // A copy of the capture to damage.
+  static fs::path copy(const std::string& name) {
+    const fs::path to = *dir_ / name;
+    fs::remove_all(to);
+    fs::copy(capture(), to, fs::copy_options::recursive);
+    return to;
+  }
+
+  static inline test::TempDir* dir_ = nullptr;
+  static inline std::string roi_, roi_image_, model_;
+};
+
+TEST_F(MeasureCli, RoiOnTheSkyFailsThatAntennaWithItsReason) {
+  const auto json = *dir_ / "sky.json";
+  const auto r = test::run_cli(
+      measure(capture(), fmt::format("--model {} --roi {}:0,0,60,60 --json '{}'", model_, roi_image_, json.string())));
+  EXPECT_EQ(r.status, 3) << r.out << r.err;
+  EXPECT_THAT(r.out, HasSubstr("FAILED"));
+  const auto j = nlohmann::json::parse(io::read_text(json));
+  ASSERT_EQ(j["antennas"].size(), 1u);
+  EXPECT_TRUE(j["antennas"][0]["azimuth_magnetic_deg"].is_null());
+  EXPECT_THAT(j["antennas"][0]["error"].get<std::string>(), HasSubstr("no texture or object in the region"));
+}
+
+TEST_F(MeasureCli, PhotosWithoutTheBoardAreNamedAndLeftOut) {
+  const auto cap = copy("no-board");
+  // Two photos lose the board (a grey frame of the same size).
+  for (const char* name : {"images/img_0001.jpg", "images/img_0004.jpg"})
+    cv::imwrite((cap / name).string(), cv::Mat(720, 960, CV_8UC1, cv::Scalar(128)));
+  const auto json = *dir_ / "no-board.json";
+  const auto r =
+      test::run_cli(measure(cap, fmt::format("--model {} --roi {} --json '{}'", model_, roi_, json.string())));
+  EXPECT_THAT(r.err, HasSubstr("img_0001.jpg: photo skipped: no board found"));
+  EXPECT_THAT(r.err, HasSubstr("img_0004.jpg: photo skipped"));
+  const auto j = nlohmann::json::parse(io::read_text(json));
+  EXPECT_EQ(j["photos"], 6);
+  EXPECT_EQ(j["photos_with_board"], 4);
+  EXPECT_EQ(j["skipped"].size(), 2u);
+
+  // The board in only one photo: no measurement, and the reasons.
+  for (const char* name : {"images/img_0000.jpg", "images/img_0002.jpg", "images/img_0003.jpg"})
+    cv::imwrite((cap / name).string(), cv::Mat(720, 960, CV_8UC1, cv::Scalar(128)));
+  const auto one = test::run_cli(measure(cap, fmt::format("--model {} --roi {}", model_, roi_)));
+  EXPECT_EQ(one.status, 3);
+  EXPECT_THAT(one.err, HasSubstr("the board was found in 1 of 6 photos; at least 2 are needed"));
+}
+
+TEST_F(MeasureCli, PhotosAllFromOnePlaceGiveNoConfidentNumber) {
+  const auto cap = copy("one-place");
+  // Every shot is the ROI's photo at (nearly) its instant: one viewpoint, no baseline.
+  std::string shots = "index,t,image\n";
+  const auto lines = io::read_text(capture() / "shots.csv");
+  const auto at = lines.find(roi_image_);
+  const auto start = lines.rfind('\n', at) + 1;
+  const double t = std::stod(lines.substr(lines.find(',', start) + 1));
+  for (int i = 0; i < 6; ++i) shots += fmt::format("{},{},{}\n", i, t + 0.02 * i, roi_image_);
+  test::write_file(cap / "shots.csv", shots);
+  const auto json = *dir_ / "one-place.json";
+  const auto r = test::run_cli(measure(cap, fmt::format("--model {} --roi {} --json '{}'", model_, roi_, json.string())));
+  EXPECT_THAT(r.err, HasSubstr("all photos were taken from nearly one direction"));
+  EXPECT_EQ(r.status, 3) << r.out << r.err;
+  const auto j = nlohmann::json::parse(io::read_text(json));
+  EXPECT_TRUE(j["antennas"][0]["azimuth_magnetic_deg"].is_null());
+  EXPECT_FALSE(j["antennas"][0]["error"].is_null());
+}
+
+TEST_F(MeasureCli, ModelInMillimetresAndOtherBadArgumentsAreNamed) {
+  // The built-in panel written in millimetres.
+  const auto panel = model::builtin_panel(model_);
+  std::string obj;
+  for (const auto& v : panel.mesh_antenna.vertices)
+    obj += fmt::format("v {} {} {}\n", 1e3 * v.x(), 1e3 * v.y(), 1e3 * v.z());
+  for (const auto& t : panel.mesh_antenna.triangles) obj += fmt::format("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1);
+  const auto mesh = *dir_ / "panel-mm.obj";
+  test::write_file(mesh, obj);
+  auto r =
+      test::run_cli(measure(capture(), fmt::format("--model '{}' --model-canonical --roi {}", mesh.string(), roi_)));
+  EXPECT_EQ(r.status, 2);
+  EXPECT_THAT(r.err, HasSubstr("--model-units mm"));
+
+  r = test::run_cli(measure(capture(), fmt::format("--model {} --roi images/nope.jpg:1,2,30,40", model_)));
+  EXPECT_EQ(r.status, 2);
+  EXPECT_THAT(r.err, HasSubstr("'images/nope.jpg' is no photo of the capture"));
+
+  r = test::run_cli(measure(capture(), fmt::format("--model {} --roi {}:900,700,100,100", model_, roi_image_)));
+  EXPECT_EQ(r.status, 2);
+  EXPECT_THAT(r.err, HasSubstr("reaches outside the 960×720 image"));
+
+  r = test::run_cli(measure(capture(), fmt::format("--model no-such-panel --roi {}", roi_)));
+  EXPECT_EQ(r.status, 2);
+  EXPECT_THAT(r.err, HasSubstr("not a built-in panel"));
+
+  r = test::run_cli(measure(capture(), fmt::format("--model {} --model {} --model {} --roi {} --roi {}", model_, model_,
+                                                   model_, roi_, roi_)));
+  EXPECT_EQ(r.status, 2);
+  EXPECT_THAT(r.err, HasSubstr("3 models for 2 regions"));
+
+  const auto bare = *dir_ / "bare.yaml";
+  test::write_file(bare, "format: antpose-device\nversion: 1\ndevice: {id: bare}\n");
+  r = test::run_cli(
+      fmt::format("measure '{}' --device '{}' --model {} --roi {}", capture().string(), bare.string(), model_, roi_));
+  EXPECT_EQ(r.status, 2);
+  EXPECT_THAT(r.err, HasSubstr("no camera intrinsics"));
+}
+
+}  // namespace
+}  // namespace antpose
