@@ -152,7 +152,7 @@ std::vector<PhotoBoardPose> board_poses(const Capture& capture, const BoardSpec&
   std::vector<std::vector<std::string>> notes(capture.shots.size());
   tbb::parallel_for(std::size_t{0}, capture.shots.size(), [&](std::size_t i) {
     const Shot& shot = capture.shots[i];
-    PhotoBoardPose p{i, shot.t, shot.image, std::nullopt, {}, shot.extra};
+    PhotoBoardPose p{i, shot.t, shot.image, std::nullopt, {}, shot.extra, {}, {}};
     const auto file = capture.root / shot.image;
     const cv::Mat image = cv::imread(file.string(), cv::IMREAD_UNCHANGED);
     if (image.empty() || image.depth() != CV_8U) {

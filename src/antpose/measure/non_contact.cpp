@@ -150,6 +150,7 @@ struct Scene {
 struct SilhouettePick {
   std::optional<registration::SilhouetteResult> best;
   double rival_deg = 0.0;
+  bool flipped_by_outline = false;  // the outline turned the points' front/back decision
   int converged = 0, tried = 0;
 };
 
@@ -188,6 +189,22 @@ SilhouettePick silhouette_search(const model::AntennaModel& model, const Iso3& T
     if (angle > options.rival_min_deg && angle < 135.0) pick.rival_deg = std::max(pick.rival_deg, angle);
   }
   pick.best = std::move(done.front());
+  // Front and back by the outline too: the brackets show in it from the side. The winner turned
+  // by 180° about the vertical is refined; clearly better, it wins; about as good, the two are
+  // ambiguous (the azimuth σ then covers both).
+  Iso3 turned = pick.best->T_board_antenna;
+  turned.linear() = Eigen::AngleAxisd(M_PI, up) * turned.linear();
+  auto flipped = registration::refine_by_silhouette(model.mesh_antenna, turned, views, scene.intrinsics,
+                                                    options.silhouette_options);
+  ++pick.tried;
+  if (flipped.converged) {
+    if (flipped.score < pick.best->score - options.silhouette_rival_margin) {
+      pick.best = std::move(flipped);
+      pick.flipped_by_outline = true;
+    } else if (flipped.score < pick.best->score + options.silhouette_rival_margin) {
+      pick.rival_deg = 180.0;
+    }
+  }
   return pick;
 }
 
@@ -215,11 +232,17 @@ void register_model(AntennaMeasurement& m, const model::AntennaModel& model, con
       m.silhouette_rms_px = pick.best->rms_px;
       m.method = fmt::format("model {}, points + outline in {} photos", model.name, pick.best->views_used);
       for (const auto& w : pick.best->warnings) m.warnings.push_back("outline: " + w);
+      if (pick.flipped_by_outline)
+        m.warnings.push_back("the outline turned the points' front/back decision (the brackets' outline fits "
+                             "clearly better the other way round)");
     } else {
-      m.warnings.push_back(
-          fmt::format("the model's outline matched the photos from none of {} starts: the yaw rests on "
-                      "the points alone",
-                      pick.tried));
+      // On the acceptance captures the points alone were tens of degrees off in yaw whenever the
+      // outline failed: no number is better than that one.
+      throw MeasurementError(fmt::format(
+          "the model's outline matched the photos from none of {} starts, and the points alone do not fix the "
+          "panel's yaw: is the whole antenna inside the photos, free of other panels in front of it, and is the "
+          "model this antenna's?",
+          pick.tried));
     }
   }
   m.R_board_antenna = T_antenna_board.rotation().transpose();

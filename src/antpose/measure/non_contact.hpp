@@ -63,13 +63,7 @@ struct NonContactSetup {
 struct NonContactOptions {
   std::string orientation = "antpose-smoother";
   reconstruction::PoseRefinementOptions poses;
-  /// From 100 points on: a weathered radome far away gives a few hundred, on its edges and
-  /// details, enough to place the model for the outline stage.
-  reconstruction::RegionOptions region = [] {
-    reconstruction::RegionOptions o;
-    o.min_points = 100;
-    return o;
-  }();
+  reconstruction::RegionOptions region;
   registration::GlobalStartOptions registration = [] {
     registration::GlobalStartOptions o;
     o.downtilt_deg = {-5.0, 5.0, 15.0};
