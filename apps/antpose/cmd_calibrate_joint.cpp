@@ -17,6 +17,7 @@
 #include "antpose/camera/board_pose.hpp"
 #include "antpose/camera/calibrate_camera.hpp"
 #include "antpose/imu/imu_calibration.hpp"
+#include "antpose/io/report_text.hpp"
 #include "antpose/io/text_file.hpp"
 #include "antpose/orientation/estimator.hpp"
 #include "commands.hpp"
@@ -36,11 +37,6 @@ struct JointArgs {
   bool fixed_time_offset = false;
 };
 
-nlohmann::json matrix_json(const Mat3& R) {
-  nlohmann::json j = nlohmann::json::array();
-  for (int r = 0; r < 3; ++r) j.push_back({R(r, 0), R(r, 1), R(r, 2)});
-  return j;
-}
 
 nlohmann::json table_json(const calibration::AngleErrorTable& t) {
   auto row = [](const calibration::AngleErrorRow& r) {
@@ -150,7 +146,7 @@ CalibrationOutcome joint_calibration(const JointArgs& args, const std::optional<
                  p.heading_deg, p.outlier ? "  outlier" : "");
     if (r.reference_check) fmt::print("{}", calibration::format_angle_error_table(*r.reference_check));
     nlohmann::json rf{{"orientation", tracks.front().method},
-                      {"R_device_camera", matrix_json(r.R_device_camera)},
+                      {"R_device_camera", io::matrix_rows_json(r.R_device_camera)},
                       {"rotation_sigma_deg", {s.x(), s.y(), s.z()}},
                       {"time_offset_s", r.time_offset_s},
                       {"time_offset_estimated", r.time_offset_estimated},
@@ -167,7 +163,7 @@ CalibrationOutcome joint_calibration(const JointArgs& args, const std::optional<
     for (const auto& b : r.boards)
       rf["boards"].push_back(
           {{"placement", b.placement},
-           {"R_world_board", matrix_json(b.R_world_board)},
+           {"R_world_board", io::matrix_rows_json(b.R_world_board)},
            {"photos", b.photos},
            {"rms_deg", b.rms_deg},
            {"gyro_bias_deg_s",
@@ -185,7 +181,7 @@ CalibrationOutcome joint_calibration(const JointArgs& args, const std::optional<
                calibration::format_thesis_tables(results));
     for (const auto& r : results)
       j["thesis"].push_back({{"orientation", r.method},
-                             {"R_device_camera", matrix_json(r.R_device_camera)},
+                             {"R_device_camera", io::matrix_rows_json(r.R_device_camera)},
                              {"rotation_sigma_deg",
                               {rad2deg(std::sqrt(r.covariance(0, 0))), rad2deg(std::sqrt(r.covariance(1, 1))),
                                rad2deg(std::sqrt(r.covariance(2, 2)))}},

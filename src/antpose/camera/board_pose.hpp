@@ -67,6 +67,11 @@ std::vector<PhotoBoardPose> board_poses(const Capture& capture, const BoardSpec&
                                         const CameraIntrinsics& intrinsics, Diagnostics& diagnostics,
                                         const DetectionOptions& options);
 
+/// The camera's optical centre in the board frame, m: −R_camera_boardᵀ t_camera_board.
+inline Vec3 camera_centre(const Mat3& R_camera_board, const Vec3& t_camera_board) {
+  return -R_camera_board.transpose() * t_camera_board;
+}
+
 /// Reprojection residuals (px) of board points with a pose: π(R p + t) − u, for each point.
 std::vector<Vec2> reprojection_residuals(const std::vector<Vec2>& image_points_px,
                                          const std::vector<Vec3>& board_points_m, const CameraIntrinsics& intrinsics,

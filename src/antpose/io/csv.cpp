@@ -102,6 +102,14 @@ double parse_number(std::string_view text, const std::filesystem::path& file, st
   return value;
 }
 
+std::optional<double> parse_finite(std::string_view s) {
+  if (!s.empty() && s.front() == '+') s.remove_prefix(1);
+  double v = 0;
+  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+  if (ec != std::errc() || end != s.data() + s.size() || !std::isfinite(v)) return std::nullopt;
+  return v;
+}
+
 std::int64_t parse_int64(std::string_view text, const std::filesystem::path& file, std::size_t line, std::string_view column) {
   std::string_view s = text;
   if (!s.empty() && s.front() == '+') s.remove_prefix(1);

@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -38,6 +39,10 @@ enum class NonFinite { kReject, kAllow };
 /// Throws InputError "<file>:<line>: column '<column>': '<text>' is not a number" etc.
 double parse_number(std::string_view text, const std::filesystem::path& file, std::size_t line,
                     std::string_view column, NonFinite non_finite = NonFinite::kReject);
+
+/// A finite decimal number ("+" allowed), or nullopt: for formats whose own errors say more
+/// than a column name (mesh and box files).
+std::optional<double> parse_finite(std::string_view text);
 
 /// Parses a decimal integer (Sensor Logger's ns time stamps) without going through a double,
 /// so 19-digit values keep every digit. Errors name the file, line, column and the text.

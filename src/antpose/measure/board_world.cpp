@@ -6,6 +6,8 @@
 #include <Eigen/Eigenvalues>
 #include <fmt/format.h>
 
+#include "antpose/camera/board_pose.hpp"
+
 namespace antpose::measure {
 namespace {
 
@@ -128,8 +130,8 @@ BoardWorldAttitude board_world_attitude(const std::vector<BoardPhoto>& photos,
   // Where the cameras were, seen from the board: camera centre in the board frame, −R_cbᵀ t_cb.
   for (std::size_t a = 0; a < used.size(); ++a)
     for (std::size_t b = a + 1; b < used.size(); ++b) {
-      const Vec3 ca = -(photos[used[a]].R_camera_board.transpose() * photos[used[a]].t_camera_board);
-      const Vec3 cb = -(photos[used[b]].R_camera_board.transpose() * photos[used[b]].t_camera_board);
+      const Vec3 ca = camera::camera_centre(photos[used[a]].R_camera_board, photos[used[a]].t_camera_board);
+      const Vec3 cb = camera::camera_centre(photos[used[b]].R_camera_board, photos[used[b]].t_camera_board);
       if (ca.norm() > 0 && cb.norm() > 0)
         out.view_spread_deg = std::max(out.view_spread_deg, rad2deg(angle_between(ca, cb)));
     }

@@ -12,6 +12,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "antpose/camera/board_pose.hpp"
+#include "antpose/io/report_text.hpp"
 #include "antpose/model/sampling.hpp"
 #include "antpose/orientation/estimator.hpp"
 
@@ -38,10 +39,6 @@ std::size_t roi_shot(const Capture& capture, const AntennaRoi& roi) {
   throw InputError("--roi", fmt::format("'{}' {} (photos: {})", roi.image,
                                         by_name.empty() ? "is no photo of the capture" : "names several photos",
                                         known.empty() ? "none" : known));
-}
-
-Vec3 camera_centre(const Mat3& R_camera_board, const Vec3& t_camera_board) {
-  return -R_camera_board.transpose() * t_camera_board;
 }
 
 // The reconstruction's rotation uncertainty from the camera poses (board frame, rad²): each
@@ -233,8 +230,9 @@ void register_model(AntennaMeasurement& m, const model::AntennaModel& model, con
       m.method = fmt::format("model {}, points + outline in {} photos", model.name, pick.best->views_used);
       for (const auto& w : pick.best->warnings) m.warnings.push_back("outline: " + w);
       if (pick.flipped_by_outline)
-        m.warnings.push_back("the outline turned the points' front/back decision (the brackets' outline fits "
-                             "clearly better the other way round)");
+        m.warnings.push_back(
+            "the outline turned the points' front/back decision (the brackets' outline fits "
+            "clearly better the other way round)");
     } else {
       // On the acceptance captures the points alone were tens of degrees off in yaw whenever the
       // outline failed: no number is better than that one.
@@ -316,12 +314,6 @@ void register_model(AntennaMeasurement& m, const model::AntennaModel& model, con
 
 nlohmann::json deg_or_null(const std::optional<double>& rad) {
   return rad ? nlohmann::json(rad2deg(*rad)) : nlohmann::json(nullptr);
-}
-
-nlohmann::json matrix_json(const Mat3& R) {
-  nlohmann::json j = nlohmann::json::array();
-  for (int r = 0; r < 3; ++r) j.push_back({R(r, 0), R(r, 1), R(r, 2)});
-  return j;
 }
 
 }  // namespace
@@ -418,7 +410,7 @@ NonContactResult measure_non_contact(const Capture& capture, const NonContactSet
 
   Scene scene{views, setup.intrinsics, {}, result.board.R_world_board.transpose() * Vec3::UnitZ()};
   for (std::size_t i = 0; i < views.size(); ++i)
-    scene.viewpoints.push_back(camera_centre(result.poses.R_camera_board[i], result.poses.t_camera_board[i]));
+    scene.viewpoints.push_back(camera::camera_centre(result.poses.R_camera_board[i], result.poses.t_camera_board[i]));
   const Mat3 cov_poses = pose_rotation_covariance(result.poses);
 
   for (std::size_t k = 0; k < setup.rois.size(); ++k) {
@@ -470,7 +462,7 @@ nlohmann::json to_json(const NonContactResult& r) {
                        {"scene_rms_px", r.poses.scene_rms_px},
                        {"tracks", r.poses.tracks},
                        {"observations", r.poses.observations}};
-  j["board"] = {{"R_world_board", matrix_json(r.board.R_world_board)},
+  j["board"] = {{"R_world_board", io::matrix_rows_json(r.board.R_world_board)},
                 {"photos_used", r.board.used},
                 {"heading_scatter_deg", r.board.heading_scatter_deg},
                 {"view_spread_deg", r.board.view_spread_deg},
@@ -507,8 +499,8 @@ nlohmann::json to_json(const NonContactResult& r) {
     a["points"] = m.region.cloud_board.size();
     a["reconstruction"] = m.region.method;
     if (ok) {
-      a["R_world_antenna"] = matrix_json(at.R_world_antenna);
-      a["R_board_antenna"] = matrix_json(m.R_board_antenna);
+      a["R_world_antenna"] = io::matrix_rows_json(at.R_world_antenna);
+      a["R_board_antenna"] = io::matrix_rows_json(m.R_board_antenna);
     }
     std::vector<std::string> warnings = ok ? at.warnings : std::vector<std::string>{};
     warnings.insert(warnings.end(), m.warnings.begin(), m.warnings.end());

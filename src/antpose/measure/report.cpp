@@ -10,6 +10,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "antpose/io/report_text.hpp"
 #include "antpose/io/text_file.hpp"
 #include "antpose/model/mesh.hpp"
 
@@ -18,29 +19,6 @@ namespace {
 namespace fs = std::filesystem;
 
 constexpr int kOverlayWidth = 1600;  // px; photos are drawn at most this wide
-
-std::string html_escape(const std::string& s) {
-  std::string out;
-  for (const char c : s) {
-    switch (c) {
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '&':
-        out += "&amp;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
-}
 
 // The antenna's box in its own frame: the model's size, or (model-free) the points' extent.
 std::pair<Vec3, Vec3> antenna_box(const AntennaMeasurement& m, const model::AntennaModel* model) {
@@ -159,7 +137,7 @@ std::string html_page(const Capture& capture, const NonContactResult& r, const s
       "body{font-family:sans-serif;margin:2em;max-width:1200px}table{border-collapse:collapse}"
       "td,th{border:1px solid #ccc;padding:4px 8px;text-align:right}th{background:#eee}"
       ".warn{color:#a04000}.err{color:#c00000}img{max-width:48%;margin:2px}</style></head><body>";
-  h += fmt::format("<h1>Antenna attitude: {}</h1>", html_escape(capture.root.filename().string()));
+  h += fmt::format("<h1>Antenna attitude: {}</h1>", io::xml_escape(capture.root.filename().string()));
   h += fmt::format(
       "<p>{} photos, the board found in {}; board attitude from {} photos (heading scatter {:.2f}°, views "
       "spread {:.0f}°); camera poses: board {:.2f} px, scene {:.2f} px RMS over {} tracks.{}</p>",
@@ -173,17 +151,17 @@ std::string html_page(const Capture& capture, const NonContactResult& r, const s
     const auto& m = r.antennas[k];
     if (m.error) {
       h += fmt::format("<tr><td>{}</td><td>{}</td><td colspan=7 class=err>{}</td></tr>", k + 1,
-                       html_escape(m.roi.image), html_escape(*m.error));
+                       io::xml_escape(m.roi.image), io::xml_escape(*m.error));
       continue;
     }
     const auto& a = m.attitude;
     h += fmt::format(
         "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{:.1f} mm</td><td>{}"
         "</td><td>{}</td></tr>",
-        k + 1, html_escape(m.roi.image), angle_cell(a.magnetic.azimuth, a.sigma.azimuth, 2),
+        k + 1, io::xml_escape(m.roi.image), angle_cell(a.magnetic.azimuth, a.sigma.azimuth, 2),
         angle_cell(a.azimuth_true, a.azimuth_true_sigma, 2), angle_cell(a.magnetic.downtilt, a.sigma.downtilt, 2),
         angle_cell(a.magnetic.roll, a.sigma.roll, 2), 1e3 * m.fit_rmse_m, m.region.cloud_board.size(),
-        html_escape(m.method));
+        io::xml_escape(m.method));
   }
   h += "</table><p>Uncertainties are 1σ. Azimuth clockwise from north, downtilt positive when the antenna points "
        "down, roll positive clockwise seen from behind (docs/non-contact.md).</p>";
@@ -196,7 +174,7 @@ std::string html_page(const Capture& capture, const NonContactResult& r, const s
   warnings.erase(std::unique(warnings.begin(), warnings.end()), warnings.end());
   if (!warnings.empty()) {
     h += "<h2>Warnings</h2><ul>";
-    for (const auto& w : warnings) h += "<li class=warn>" + html_escape(w) + "</li>";
+    for (const auto& w : warnings) h += "<li class=warn>" + io::xml_escape(w) + "</li>";
     h += "</ul>";
   }
   h += "<h2>Plan view</h2>";
@@ -210,7 +188,7 @@ std::string html_page(const Capture& capture, const NonContactResult& r, const s
   for (const auto& o : overlays) h += fmt::format("<a href=\"{0}\"><img src=\"{0}\"></a>", o);
   if (!r.skipped.empty()) {
     h += "<h2>Photos not used</h2><ul>";
-    for (const auto& s : r.skipped) h += "<li>" + html_escape(s) + "</li>";
+    for (const auto& s : r.skipped) h += "<li>" + io::xml_escape(s) + "</li>";
     h += "</ul>";
   }
   return h + "</body></html>\n";

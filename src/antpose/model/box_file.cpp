@@ -13,6 +13,7 @@
 #include <fmt/format.h>
 
 #include "antpose/core/error.hpp"
+#include "antpose/io/csv.hpp"
 #include "antpose/io/text_file.hpp"
 
 namespace antpose::model {
@@ -159,13 +160,6 @@ void check_right_handed(const Mat3& edges, const fs::path& file) {
                                      likely));
 }
 
-std::optional<double> parse_number(std::string_view s) {
-  if (!s.empty() && s.front() == '+') s.remove_prefix(1);
-  double v = 0;
-  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-  if (ec != std::errc() || end != s.data() + s.size() || !std::isfinite(v)) return std::nullopt;
-  return v;
-}
 
 int corner_index(const std::string& label, const fs::path& file, std::size_t line) {
   if (label.size() == 1) {
@@ -221,7 +215,7 @@ AntennaBox parse_box_file(const std::string& text, const fs::path& file, Units u
     if (lines[k] != 0)
       throw InputError(file, number, fmt::format("corner {} given twice (first on line {})", kLabels[k], lines[k]));
     for (int a = 0; a < 3; ++a) {
-      const auto v = parse_number(t[a + 1]);
+      const auto v = io::parse_finite(t[a + 1]);
       if (!v) throw InputError(file, number, fmt::format("bad number '{}' for corner {}", t[a + 1], kLabels[k]));
       corners[k][a] = *v * metres_per_unit(units);
     }

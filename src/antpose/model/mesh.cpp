@@ -13,6 +13,7 @@
 #include <fmt/format.h>
 
 #include "antpose/core/error.hpp"
+#include "antpose/io/csv.hpp"
 #include "antpose/io/text_file.hpp"
 
 namespace antpose::model {
@@ -24,14 +25,6 @@ namespace {
 // bounds the file is in another unit or holds more than the antenna (e.g. a whole mast scan).
 constexpr double kMaxExtentM = 10.0;
 constexpr double kMinExtentM = 0.05;
-
-std::optional<double> parse_double(std::string_view s) {
-  if (!s.empty() && s.front() == '+') s.remove_prefix(1);
-  double v = 0;
-  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-  if (ec != std::errc() || end != s.data() + s.size() || !std::isfinite(v)) return std::nullopt;
-  return v;
-}
 
 std::optional<long long> parse_int(std::string_view s) {
   if (!s.empty() && s.front() == '+') s.remove_prefix(1);
@@ -101,7 +94,7 @@ Vec3 obj_vertex(const std::vector<std::string_view>& tokens, const fs::path& fil
     throw InputError(file, line, fmt::format("vertex has {} coordinates, expected 3 (v x y z)", tokens.size() - 1));
   Vec3 v;
   for (int k = 0; k < 3; ++k) {
-    const auto x = parse_double(tokens[k + 1]);
+    const auto x = io::parse_finite(tokens[k + 1]);
     if (!x)
       throw InputError(file, line, fmt::format("bad number '{}' in vertex, expected a finite number", tokens[k + 1]));
     v[k] = *x;
@@ -311,7 +304,7 @@ class AsciiCursor {
       if (const auto v = parse_int(s)) return static_cast<double>(*v);
       fail(fmt::format("bad number '{}', expected an integer", s));
     }
-    if (const auto v = parse_double(s)) return *v;
+    if (const auto v = io::parse_finite(s)) return *v;
     fail(fmt::format("bad number '{}', expected a finite number", s));
   }
 

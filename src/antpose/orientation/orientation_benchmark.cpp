@@ -10,6 +10,7 @@
 
 #include <fmt/format.h>
 
+#include "antpose/io/report_text.hpp"
 #include "antpose/orientation/filters.hpp"
 #include "antpose/orientation/static_orientation.hpp"
 
@@ -214,16 +215,6 @@ std::string colour(double u) {
   return fmt::format("#{:02x}{:02x}{:02x}", rgb[0], rgb[1], rgb[2]);
 }
 
-std::string escape(const std::string& s) {
-  std::string o;
-  for (char ch : s) {
-    if (ch == '&') o += "&amp;";
-    else if (ch == '<') o += "&lt;";
-    else if (ch == '>') o += "&gt;";
-    else o += ch;
-  }
-  return o;
-}
 
 }  // namespace
 
@@ -241,7 +232,7 @@ std::string heatmap_svg(const Heatmap& map) {
       "font-size=\"11\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n",
       width, height);
   s += fmt::format("<text x=\"{:.0f}\" y=\"24\" font-size=\"15\" text-anchor=\"middle\">{}</text>\n",
-                   left + cols * cell_w / 2, escape(map.title));
+                   left + cols * cell_w / 2, io::xml_escape(map.title));
   for (Eigen::Index r = 0; r < rows; ++r) {
     const double y = top + r * cell_h;
     s += fmt::format("<text x=\"{:.0f}\" y=\"{:.1f}\" text-anchor=\"end\">{}</text>\n", left - 6, y + cell_h / 2 + 4,
@@ -258,10 +249,10 @@ std::string heatmap_svg(const Heatmap& map) {
     s += fmt::format("<text x=\"{:.1f}\" y=\"{:.0f}\" text-anchor=\"middle\">{:g}</text>\n", left + c * cell_w + cell_w / 2,
                      top + rows * cell_h + 16, map.x_values[static_cast<std::size_t>(c)]);
   s += fmt::format("<text x=\"{:.1f}\" y=\"{:.0f}\" text-anchor=\"middle\" font-size=\"13\">{}</text>\n",
-                   left + cols * cell_w / 2, top + rows * cell_h + 40, escape(map.x_label));
+                   left + cols * cell_w / 2, top + rows * cell_h + 40, io::xml_escape(map.x_label));
   s += fmt::format(
       "<text x=\"20\" y=\"{:.1f}\" text-anchor=\"middle\" font-size=\"13\" transform=\"rotate(-90 20 {:.1f})\">{}</text>\n",
-      top + rows * cell_h / 2, top + rows * cell_h / 2, escape(map.y_label));
+      top + rows * cell_h / 2, top + rows * cell_h / 2, io::xml_escape(map.y_label));
   // Colour bar: top = max.
   const double bx = left + cols * cell_w + 24, bh = rows * cell_h;
   const int steps = 50;
@@ -269,9 +260,9 @@ std::string heatmap_svg(const Heatmap& map) {
     s += fmt::format("<rect x=\"{:.0f}\" y=\"{:.2f}\" width=\"{:.0f}\" height=\"{:.2f}\" fill=\"{}\"/>\n", bx,
                      top + bh * i / steps, bar_w, bh / steps + 0.5, colour(1.0 - (i + 0.5) / steps));
   s += fmt::format("<text x=\"{:.0f}\" y=\"{:.0f}\">{:.{}f} {}</text>\n", bx + bar_w + 4, top + 10, hi,
-                   map.value_decimals, escape(map.unit));
+                   map.value_decimals, io::xml_escape(map.unit));
   s += fmt::format("<text x=\"{:.0f}\" y=\"{:.0f}\">{:.{}f} {}</text>\n", bx + bar_w + 4, top + bh, lo,
-                   map.value_decimals, escape(map.unit));
+                   map.value_decimals, io::xml_escape(map.unit));
   s += "</svg>\n";
   return s;
 }

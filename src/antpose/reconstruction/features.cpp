@@ -8,6 +8,8 @@
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "antpose/camera/board_pose.hpp"
+
 namespace antpose::reconstruction::detail {
 
 ViewFeatures detect_features(const cv::Mat& image, const cv::Mat& mask, const cv::Rect& area, int max_features,
@@ -171,11 +173,11 @@ std::optional<Vec3> triangulate_track(std::vector<Observation>& track, const std
     double best = 0;  // largest angle between two rays: a small one leaves depth undetermined
     for (std::size_t a = 0; a < track.size(); ++a) {
       const int va = track[a].first;
-      const Vec3 ca = -R_camera_board[va].transpose() * t_camera_board[va];
+      const Vec3 ca = camera::camera_centre(R_camera_board[va], t_camera_board[va]);
       if ((ca - *X).norm() > checks.max_depth_m) return std::nullopt;
       for (std::size_t b = a + 1; b < track.size(); ++b) {
         const int vb = track[b].first;
-        const Vec3 cb = -R_camera_board[vb].transpose() * t_camera_board[vb];
+        const Vec3 cb = camera::camera_centre(R_camera_board[vb], t_camera_board[vb]);
         best = std::max(best, angle_between(ca - *X, cb - *X));
       }
     }
