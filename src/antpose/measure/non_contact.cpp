@@ -8,6 +8,7 @@
 #include <tuple>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 
@@ -138,26 +139,56 @@ struct Scene {
   const camera::CameraIntrinsics& intrinsics;
   std::vector<Vec3> viewpoints;  // camera centres, board frame
   Vec3 up_board;
+  std::vector<std::vector<cv::Point2f>> board_outlines;  // per view, px; empty when not in front
 };
+
+// The board's outline in a photo (px, as taken): its printed extent plus the white margin.
+std::vector<cv::Point2f> board_outline(const camera::BoardSpec& board, const camera::CameraIntrinsics& K,
+                                       const Mat3& R_camera_board, const Vec3& t_camera_board, double margin_m) {
+  const auto [lo, hi] = board.extent();
+  std::vector<cv::Point2f> poly;
+  for (const Vec2& c : {Vec2(lo.x() - margin_m, lo.y() - margin_m), Vec2(hi.x() + margin_m, lo.y() - margin_m),
+                        Vec2(hi.x() + margin_m, hi.y() + margin_m), Vec2(lo.x() - margin_m, hi.y() + margin_m)}) {
+    const Vec3 p = R_camera_board * Vec3(c.x(), c.y(), 0.0) + t_camera_board;
+    if (p.z() <= 1e-3) return {};
+    const auto uv = K.project(p);
+    if (!uv) return {};
+    poly.emplace_back(static_cast<float>(uv->x()), static_cast<float>(uv->y()));
+  }
+  return poly;
+}
+
+// The photos as the outline sees them. No ROI: each start's crop follows its projection (a
+// carried ROI may cut the outline).
+std::vector<registration::SilhouetteView> silhouette_views(const Scene& scene) {
+  std::vector<registration::SilhouetteView> views;
+  for (std::size_t i = 0; i < scene.views.size(); ++i) {
+    const auto& v = scene.views[i];
+    views.push_back({v.image, v.R_camera_board, v.t_camera_board, {}, {}});
+    if (!scene.board_outlines[i].empty()) views.back().occluders.push_back(scene.board_outlines[i]);
+  }
+  return views;
+}
 
 // The silhouette stage: starts turned about the vertical from the points' pose by each start
 // angle, refined by the outline in every photo; the converged result with the lowest score (the
-// outline's mean truncated edge cost) wins. `rival_deg`: the largest boresight angle to another
-// converged result scoring within options.silhouette_rival_margin of the winner.
+// outline's mean truncated edge cost) wins. `rivals`: other converged results scoring within
+// options.silhouette_rival_margin of the winner whose boresight is more than rival_min_deg away
+// (the winner turned by 180° included): the attitude's σ covers them.
 struct SilhouettePick {
   std::optional<registration::SilhouetteResult> best;
-  double rival_deg = 0.0;
+  std::vector<Mat3> rivals;         // R_board_antenna of each rival
   bool flipped_by_outline = false;  // the outline turned the points' front/back decision
   int converged = 0, tried = 0;
+  std::vector<std::string> closest_failure;  // the best-scoring rejected start's reasons, when none converged
 };
 
 SilhouettePick silhouette_search(const model::AntennaModel& model, const Iso3& T_board_antenna, const Scene& scene,
                                  const NonContactOptions& options) {
-  // No ROI: each start's crop follows its projection (a carried ROI may cut the outline).
-  std::vector<registration::SilhouetteView> views;
-  for (const auto& v : scene.views) views.push_back({v.image, v.R_camera_board, v.t_camera_board, {}});
+  const auto views = silhouette_views(scene);
   SilhouettePick pick;
   std::vector<registration::SilhouetteResult> done;
+  double failed_score = 2.0;
   // Starts upright (the long axis along the board frame's up: panels hang within ~15° of it),
   // turned about it from the points' boresight, at the points' position. The points' own tilt
   // is not kept: on a cluttered region it can be the wrong basin for the outline.
@@ -174,35 +205,87 @@ SilhouettePick silhouette_search(const model::AntennaModel& model, const Iso3& T
     ++pick.tried;
     auto r = registration::refine_by_silhouette(model.mesh_antenna, start, views, scene.intrinsics,
                                                 options.silhouette_options);
-    if (r.converged) done.push_back(std::move(r));
+    if (r.converged)
+      done.push_back(std::move(r));
+    else if (failed_score > r.score)
+      failed_score = r.score, pick.closest_failure = r.warnings;
   }
   pick.converged = static_cast<int>(done.size());
   if (done.empty()) return pick;
   std::sort(done.begin(), done.end(), [](const auto& a, const auto& b) { return a.score < b.score; });
-  const Vec3 boresight = done.front().T_board_antenna.linear().col(1);
-  for (std::size_t i = 1; i < done.size(); ++i) {
-    if (done[i].score - done.front().score > options.silhouette_rival_margin) break;
-    const double angle = rad2deg(angle_between(done[i].T_board_antenna.linear().col(1), boresight));
-    if (angle > options.rival_min_deg && angle < 135.0) pick.rival_deg = std::max(pick.rival_deg, angle);
-  }
+  const auto is_rival = [&](const registration::SilhouetteResult& r, const registration::SilhouetteResult& best) {
+    return r.score < best.score + options.silhouette_rival_margin &&
+           rad2deg(angle_between(r.T_board_antenna.linear().col(1), best.T_board_antenna.linear().col(1))) >
+               options.rival_min_deg;
+  };
+  for (std::size_t i = 1; i < done.size(); ++i)
+    if (is_rival(done[i], done.front())) pick.rivals.push_back(done[i].T_board_antenna.linear());
   pick.best = std::move(done.front());
   // Front and back by the outline too: the brackets show in it from the side. The winner turned
-  // by 180° about the vertical is refined; clearly better, it wins; about as good, the two are
-  // ambiguous (the azimuth σ then covers both).
+  // by 180° about its own long axis (the same line in the photos, the boresight reversed and the
+  // downtilt's sign with it) is refined; clearly better, it wins; about as good, it is a rival.
   Iso3 turned = pick.best->T_board_antenna;
-  turned.linear() = Eigen::AngleAxisd(M_PI, up) * turned.linear();
+  turned.linear() = turned.linear() * Eigen::AngleAxisd(M_PI, Vec3::UnitZ()).toRotationMatrix();
   auto flipped = registration::refine_by_silhouette(model.mesh_antenna, turned, views, scene.intrinsics,
                                                     options.silhouette_options);
   ++pick.tried;
   if (flipped.converged) {
     if (flipped.score < pick.best->score - options.silhouette_rival_margin) {
+      pick.rivals.clear();
       pick.best = std::move(flipped);
       pick.flipped_by_outline = true;
-    } else if (flipped.score < pick.best->score + options.silhouette_rival_margin) {
-      pick.rival_deg = 180.0;
+    } else if (is_rival(flipped, *pick.best)) {
+      pick.rivals.push_back(flipped.T_board_antenna.linear());
     }
   }
   return pick;
+}
+
+// The points fix the panel's long axis (thousands of points along 1.3–2 m); the outline fixes the
+// yaw about it. Seen from below, the outline may instead slide in tilt along the line of sight
+// (the mast's and the clamps' edges beside it fit as well): when the points' axis, refined from
+// the outline's pose, lies more than options.axis_gate_deg away, the outline is refined again
+// with the axis held to the points' and only the yaw and position free. Returns the rotation
+// covariance (board frame) to use, or nothing when the outline's own stands.
+std::optional<Mat3> hold_axis_to_points(AntennaMeasurement& m, Iso3& T_antenna_board, const Mat3& cov_outline,
+                                        const model::AntennaModel& model, const registration::PreparedCloud& cloud,
+                                        const registration::PreparedCloud& model_prepared, const Scene& scene,
+                                        const NonContactOptions& options) {
+  const auto icp = registration::align(cloud, model_prepared, T_antenna_board, options.registration.fine);
+  const Mat3 R_outline = T_antenna_board.rotation().transpose();
+  const Vec3 axis_points = icp.T_target_source.rotation().transpose().col(2);
+  const double disagreement = angle_between(R_outline.col(2), axis_points);
+  if (rad2deg(disagreement) <= options.axis_gate_deg) return std::nullopt;
+
+  Iso3 start = T_antenna_board.inverse();
+  start.linear() = Eigen::Quaterniond::FromTwoVectors(R_outline.col(2), axis_points).toRotationMatrix() * R_outline;
+  const Mat3& R = start.linear();
+  // Held: a prior far tighter than either measurement on the two rotations that move the axis.
+  const double held = deg2rad(0.01);
+  registration::RotationPrior prior{R, R * Vec3(1 / (held * held), 1 / (held * held), 0).asDiagonal() * R.transpose()};
+  const auto r = registration::refine_by_silhouette(model.mesh_antenna, start, silhouette_views(scene),
+                                                    scene.intrinsics, options.silhouette_options, prior);
+  const Mat3 R_held = r.T_board_antenna.linear();
+  const double sa = deg2rad(options.points_axis_sigma_deg);
+  if (r.converged) {
+    m.warnings.push_back(fmt::format(
+        "the outline's long axis lay {:.1f}° from the points' (seen from below it can slide along the line of "
+        "sight): the points' axis is kept and the outline fixes the yaw about it",
+        rad2deg(disagreement)));
+    T_antenna_board = r.T_board_antenna.inverse();
+    return Mat3(r.covariance.topLeftCorner<3, 3>() +
+                R_held * Vec3(sa * sa, sa * sa, 0).asDiagonal() * R_held.transpose());
+  }
+  // The outline fits only with its own axis. The points' axis is still the likelier (the
+  // development sites: the points within 0.43° wherever the two disagreed, the outline 4–7° off),
+  // but the σ covers both.
+  m.warnings.push_back(fmt::format(
+      "the outline's long axis lies {:.1f}° from the points', and the outline does not fit with the points' axis: "
+      "the points' axis is kept, and the downtilt and roll σ cover both",
+      rad2deg(disagreement)));
+  T_antenna_board = start.inverse();
+  const double d = disagreement / 2;
+  return Mat3(cov_outline + R * Vec3(d * d, d * d, 0).asDiagonal() * R.transpose());
 }
 
 void register_model(AntennaMeasurement& m, const model::AntennaModel& model, const Scene& scene,
@@ -218,30 +301,30 @@ void register_model(AntennaMeasurement& m, const model::AntennaModel& model, con
   m.front_back_margin = g.front_back_margin;
 
   // The outline decides the yaw where the points cannot (docs/non-contact.md).
-  double rival_deg = 0.0;
   std::optional<Mat3> cov_silhouette;
   if (options.silhouette) {
     const auto pick = silhouette_search(model, T_antenna_board.inverse(), scene, options);
-    if (pick.best) {
-      T_antenna_board = pick.best->T_board_antenna.inverse();
-      cov_silhouette = pick.best->covariance.topLeftCorner<3, 3>();
-      rival_deg = pick.rival_deg;
-      m.silhouette_rms_px = pick.best->rms_px;
-      m.method = fmt::format("model {}, points + outline in {} photos", model.name, pick.best->views_used);
-      for (const auto& w : pick.best->warnings) m.warnings.push_back("outline: " + w);
-      if (pick.flipped_by_outline)
-        m.warnings.push_back(
-            "the outline turned the points' front/back decision (the brackets' outline fits "
-            "clearly better the other way round)");
-    } else {
+    if (!pick.best)
       // On the acceptance captures the points alone were tens of degrees off in yaw whenever the
       // outline failed: no number is better than that one.
       throw MeasurementError(fmt::format(
           "the model's outline matched the photos from none of {} starts, and the points alone do not fix the "
           "panel's yaw: is the whole antenna inside the photos, free of other panels in front of it, and is the "
-          "model this antenna's?",
-          pick.tried));
-    }
+          "model this antenna's? (closest start: {})",
+          pick.tried, fmt::join(pick.closest_failure, "; ")));
+    T_antenna_board = pick.best->T_board_antenna.inverse();
+    cov_silhouette = pick.best->covariance.topLeftCorner<3, 3>();
+    m.rivals_board = pick.rivals;
+    m.silhouette_rms_px = pick.best->rms_px;
+    m.method = fmt::format("model {}, points + outline in {} photos", model.name, pick.best->views_used);
+    for (const auto& w : pick.best->warnings) m.warnings.push_back("outline: " + w);
+    if (pick.flipped_by_outline)
+      m.warnings.push_back(
+          "the outline turned the points' front/back decision (the brackets' outline fits "
+          "clearly better the other way round)");
+    if (const auto held =
+            hold_axis_to_points(m, T_antenna_board, *cov_silhouette, model, cloud, model_prepared, scene, options))
+      cov_silhouette = held;
   }
   m.R_board_antenna = T_antenna_board.rotation().transpose();
   m.p_board_antenna = T_antenna_board.inverse().translation();
@@ -281,14 +364,17 @@ void register_model(AntennaMeasurement& m, const model::AntennaModel& model, con
           "front and back are ambiguous: the model turned 180° fits nearly as well (margin {:.3f}); photograph the "
           "antenna from further round its side, or check the azimuth by eye",
           g.front_back_margin));
-    // Any other yaw that fits the points nearly as well (coarse scores) makes the azimuth that uncertain.
+    // Any other yaw that fits the points nearly as well (coarse scores) is a rival.
     const Vec3 boresight = m.R_board_antenna.col(1);
     for (const auto& h : g.hypotheses) {
-      const double angle = rad2deg(angle_between(h.T_model_scene.rotation().transpose().col(1), boresight));
+      const Mat3 R = h.T_model_scene.rotation().transpose();
+      const double angle = rad2deg(angle_between(R.col(1), boresight));
       if (angle > options.rival_min_deg && angle <= 90.0 &&
           h.score() - g.hypotheses.front().score() < gopts.ambiguity_margin)
-        rival_deg = std::max(rival_deg, angle);
+        m.rivals_board.push_back(R);
     }
+    if (g.front_back_ambiguous)
+      m.rivals_board.push_back(Eigen::AngleAxisd(M_PI, scene.up_board.normalized()) * m.R_board_antenna);
   }
   const double covered = extent_along(m.region.cloud_board, m.R_board_antenna.col(2));
   if (covered < 0.6 * model.size_m.z())
@@ -301,15 +387,33 @@ void register_model(AntennaMeasurement& m, const model::AntennaModel& model, con
                     : Mat3(m.R_board_antenna *
                            bootstrap_covariance(m.region.cloud_board, model_prepared, T_antenna_board, options) *
                            m.R_board_antenna.transpose());
-  if (rival_deg > 0.0) {
-    m.warnings.push_back(
-        fmt::format("the registration is ambiguous: the model turned {:.0f}° about its axis fits "
-                    "nearly as well; the azimuth's σ includes it",
-                    rival_deg));
-    const Vec3 axis = m.R_board_antenna.col(2);
-    m.cov_board += std::pow(deg2rad(rival_deg) / 2.0, 2) * axis * axis.transpose();
-  }
   m.model_board = transformed(model_cloud, T_antenna_board.inverse());
+}
+
+// Each rival pose widens each angle's σ to half its difference from the result (the spread of a
+// two-way mixture), with a warning naming the largest turn.
+void widen_for_rivals(AntennaMeasurement& m, const BoardWorldAttitude& board,
+                      const std::optional<geomag::SiteField>& site) {
+  if (m.rivals_board.empty()) return;
+  auto& at = m.attitude;
+  double turn = 0.0;
+  const auto widen = [](auto& sigma, double difference) {
+    if (sigma) sigma = std::hypot(*sigma, difference / 2);
+  };
+  for (const Mat3& R : m.rivals_board) {
+    turn = std::max(turn, angle_between(R.col(1), m.R_board_antenna.col(1)));
+    const auto other = antenna_attitude(board, R, Mat3::Zero(), site).magnetic;
+    if (at.magnetic.azimuth && other.azimuth) {
+      const double d = std::abs(wrap_pi(*other.azimuth - *at.magnetic.azimuth));
+      widen(at.sigma.azimuth, d);
+      widen(at.azimuth_true_sigma, d);
+    }
+    at.sigma.downtilt = std::hypot(at.sigma.downtilt, (other.downtilt - at.magnetic.downtilt) / 2);
+    if (at.magnetic.roll && other.roll) widen(at.sigma.roll, std::abs(wrap_pi(*other.roll - *at.magnetic.roll)));
+  }
+  m.warnings.push_back(fmt::format(
+      "the registration is ambiguous: the model turned {:.0f}° fits nearly as well; the σ of each angle covers it",
+      rad2deg(turn)));
 }
 
 nlohmann::json deg_or_null(const std::optional<double>& rad) {
@@ -408,10 +512,22 @@ NonContactResult measure_non_contact(const Capture& capture, const NonContactSet
     }
   }
 
-  Scene scene{views, setup.intrinsics, {}, result.board.R_world_board.transpose() * Vec3::UnitZ()};
-  for (std::size_t i = 0; i < views.size(); ++i)
-    scene.viewpoints.push_back(camera::camera_centre(result.poses.R_camera_board[i], result.poses.t_camera_board[i]));
+  Scene scene{views, setup.intrinsics, {}, result.board.R_world_board.transpose() * Vec3::UnitZ(), {}};
+  for (std::size_t i = 0; i < views.size(); ++i) {
+    const auto& R = result.poses.R_camera_board[i];
+    const auto& t = result.poses.t_camera_board[i];
+    scene.viewpoints.push_back(camera::camera_centre(R, t));
+    scene.board_outlines.push_back(
+        board_outline(setup.board, setup.intrinsics, R, t, options.board_margin_squares * setup.board.square_m));
+  }
   const Mat3 cov_poses = pose_rotation_covariance(result.poses);
+  auto region_options = options.region;
+  {
+    const auto [lo, hi] = setup.board.extent();
+    const double margin = options.board_margin_squares * setup.board.square_m;
+    region_options.exclude_board = {lo - Vec3(margin, margin, options.board_thickness_m),
+                                    hi + Vec3(margin, margin, options.board_thickness_m)};
+  }
 
   for (std::size_t k = 0; k < setup.rois.size(); ++k) {
     AntennaMeasurement m;
@@ -426,7 +542,7 @@ NonContactResult measure_non_contact(const Capture& capture, const NonContactSet
                         m.roi.image, board_poses[roi_shots[k]].reason));
       const auto view = static_cast<std::size_t>(at - result.posed.begin());
       m.region = reconstruction::reconstruct_region(
-          views, result.poses, view, m.roi.roi, setup.intrinsics, options.region,
+          views, result.poses, view, m.roi.roi, setup.intrinsics, region_options,
           [&](const std::string& s, int d, int t) { report(options, name + ": " + s, d, t); });
       for (const auto& w : m.region.warnings) m.warnings.push_back(w);
       report(options, name + ": registration", 0, 1);
@@ -445,6 +561,7 @@ NonContactResult measure_non_contact(const Capture& capture, const NonContactSet
       report(options, name + ": registration", 1, 1);
       m.cov_board += cov_poses;
       m.attitude = antenna_attitude(result.board, m.R_board_antenna, m.cov_board, result.site);
+      widen_for_rivals(m, result.board, result.site);
     } catch (const MeasurementError& e) {
       m.error = e.what();
     }

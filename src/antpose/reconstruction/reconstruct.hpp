@@ -79,6 +79,10 @@ struct RegionOptions {
   double sor_std_ratio = 2.0;    // and the threshold in standard deviations
   double max_depth_m = 60.0;     // ignore points farther from every camera
   std::size_t min_points = 200;  // fewer: MeasurementError (e.g. an ROI on no antenna)
+  /// Points inside this board-frame box (min, max corner) are not the object: the calibration
+  /// board itself when the rectangle overlaps it (nearer, and far better textured, it would
+  /// otherwise be taken for the object).
+  std::optional<std::pair<Vec3, Vec3>> exclude_board;
 };
 
 struct RegionReconstruction {

@@ -71,7 +71,8 @@ struct DepthRange {
   Vec3 centre_board = Vec3::Zero();
 };
 
-/// The nearest window of depths holding at least `min_support` points, shifted within its
+/// The nearest window of depths holding at least `min_support` points and a fifth of the
+/// fullest window's, shifted within its
 /// width to the position that holds most points (the cluster's centre), widened by a margin.
 /// Nearest, not densest: whatever else a rectangle drawn around an antenna holds (sky, ground,
 /// buildings, trees) lies behind the antenna, and may carry more texture than its radome.
@@ -88,9 +89,14 @@ std::optional<DepthRange> nearest_depth_cluster(const std::vector<Vec3>& points_
     while (hi < z.size() && z[hi].first <= z[lo].first + width(lo)) ++hi;
     return hi;
   };
+  // The nearest cluster holding a fifth of the largest's support: a few stray triangulations
+  // nearer than the object (the board's edge, the tripod) are no cluster.
+  std::size_t largest = 0;
+  for (std::size_t lo = 0; lo < z.size(); ++lo) largest = std::max(largest, end_of(lo) - lo);
+  const std::size_t needed = std::max(min_support, largest / 5);
   std::size_t first = z.size();
   for (std::size_t lo = 0; lo < z.size(); ++lo)
-    if (end_of(lo) - lo >= min_support) {
+    if (end_of(lo) - lo >= needed) {
       first = lo;
       break;
     }
@@ -128,6 +134,7 @@ struct DenseContext {
   DepthRange range;
   std::vector<Vec3> volume;  // board-frame samples of the region's volume
   double max_depth_m;
+  const RegionOptions* options;
 };
 
 /// Bounding box of points (cv::Rect's union ignores empty rectangles, so points need this).
@@ -151,7 +158,13 @@ bool inside(const Roi& r, const Vec2& p) {
 
 /// The volume check shared by dense and sparse points: inside the reference ROI, within the
 /// depth range, within max_depth of every camera that might see it.
+bool excluded(const RegionOptions& o, const Vec3& p) {
+  return o.exclude_board && (p.array() >= o.exclude_board->first.array()).all() &&
+         (p.array() <= o.exclude_board->second.array()).all();
+}
+
 bool in_volume(const DenseContext& c, const Vec3& p) {
+  if (excluded(*c.options, p)) return false;
   const Mat3& R = c.poses->R_camera_board[c.roi_view];
   const Vec3& t = c.poses->t_camera_board[c.roi_view];
   const Vec3 pc = R * p + t;
@@ -475,6 +488,7 @@ RegionReconstruction reconstruct_region(const std::vector<PosedView>& views, con
   for (auto& track : tracks)
     if (auto X = detail::triangulate_track(track, features, poses.R_camera_board, poses.t_camera_board, intrinsics,
                                            checks)) {
+      if (excluded(options, *X)) continue;
       sparse.push_back(*X);
       sparse_tracks.push_back(track);
     }
@@ -490,7 +504,7 @@ RegionReconstruction reconstruct_region(const std::vector<PosedView>& views, con
         "no texture or object in the region of {}: only {} feature points could be triangulated there (at least {} "
         "on one object are needed to find its distance); draw the region tightly around the antenna",
         ref.name, range ? range->support : 0, kMinSparse));
-  DenseContext ctx{&views, &poses, &intrinsics, roi_view, roi, *range, {}, options.max_depth_m};
+  DenseContext ctx{&views, &poses, &intrinsics, roi_view, roi, *range, {}, options.max_depth_m, &options};
   ctx.volume = frustum_samples(roi, Rr, tr, intrinsics, {range->near, 0.5 * (range->near + range->far), range->far});
   out.rois.assign(n, std::nullopt);
   out.rois[roi_view] = roi;

@@ -69,8 +69,18 @@ struct PreparedView {
   Vec3 t_cb = Vec3::Zero();
   Vec2 offset = Vec2::Zero();  // crop origin, full-resolution px
   cv::Size size;
-  std::vector<cv::Mat> gx, gy;  // CV_32F per level
+  std::vector<cv::Mat> gx, gy;                      // CV_32F per level
+  std::vector<std::vector<cv::Point2f>> occluders;  // full-resolution px
 };
+
+// Whether an outline point lies on a known nearer object or within `margin_px` of its border
+// (whose edge the search would take for the antenna's).
+bool occluded(const PreparedView& v, const Vec2& p, double margin_px) {
+  const cv::Point2f q(static_cast<float>(p.x()), static_cast<float>(p.y()));
+  for (const auto& poly : v.occluders)
+    if (cv::pointPolygonTest(poly, q, true) >= -margin_px) return true;
+  return false;
+}
 
 struct Sample {
   Vec2 normal;                    // outward, image
@@ -188,6 +198,7 @@ void gather(const EdgeMesh& m, const Pose& pose, const PreparedView& v, const ca
       const bool in_minus = inside(q - k * normal), in_plus = inside(q + k * normal);
       if (in_minus == in_plus) continue;  // inner edge, or hidden by another part of the model
       if (in_plus) normal = -normal;
+      if (!v.occluders.empty() && occluded(v, *p, (search_px + 2) * scale)) continue;
       ++candidates;
       const Vec2 in_crop = *p - v.offset;
       if (in_crop.x() < 0 || in_crop.y() < 0 || in_crop.x() > v.size.width - 1 || in_crop.y() > v.size.height - 1) {
@@ -344,6 +355,20 @@ double score(const Gathered& g, const SilhouetteOptions& o) {
   return (sum + double(g.candidates - found)) / double(g.candidates);
 }
 
+// Adds the rotation prior to the normal equations as a measurement of the edges' units: its
+// information × the edges' residual variance × the correlation inflation (so that it weighs as a
+// Gaussian of its own covariance would against theirs). Returns that factor (0 without a prior).
+double add_prior(Normal& n, const Mat3& R_board_antenna, const std::optional<RotationPrior>& prior,
+                 const SilhouetteOptions& o) {
+  if (!prior || n.sum_w <= 0) return 0.0;
+  const double sigma2 = std::max(n.sum_wr2 / n.sum_w, 0.25 * 0.25);
+  const double weight = sigma2 * std::max(1.0, o.correlation_length_px / o.sample_spacing_px);
+  const Vec3 r = log_so3(prior->R_board_antenna * R_board_antenna.transpose());
+  n.H.topLeftCorner<3, 3>() += weight * prior->information;
+  n.b.head<3>() += weight * prior->information * r;
+  return weight;
+}
+
 struct Descent {
   Pose pose;
   bool converged = false;
@@ -355,7 +380,8 @@ struct Descent {
 
 SilhouetteResult refine_by_silhouette(const model::Mesh& mesh_antenna, const Iso3& T_board_antenna_initial,
                                       const std::vector<SilhouetteView>& views,
-                                      const camera::CameraIntrinsics& intrinsics, const SilhouetteOptions& options) {
+                                      const camera::CameraIntrinsics& intrinsics, const SilhouetteOptions& options,
+                                      const std::optional<RotationPrior>& prior) {
   if (mesh_antenna.triangles.empty()) throw std::invalid_argument("refine_by_silhouette: the mesh has no triangles");
   const EdgeMesh m = weld(mesh_antenna);
   SilhouetteResult result;
@@ -373,6 +399,7 @@ SilhouetteResult refine_by_silhouette(const model::Mesh& mesh_antenna, const Iso
                                               intrinsics.width, intrinsics.height));
     auto& v = prepared[i];
     v.R_cb = in.R_camera_board;
+    v.occluders = in.occluders;
     v.t_cb = in.t_camera_board;
     const auto box = projected_box(intrinsics, v, m, pose);
     if (!box) {
@@ -444,8 +471,9 @@ SilhouetteResult refine_by_silhouette(const model::Mesh& mesh_antenna, const Iso
       d.converged = false;
       for (int it = 0; it < options.max_iterations_per_level; ++it) {
         const Gathered g = gather_all(m, d.pose, prepared, intrinsics, level, search, options);
-        const Normal n = normal_equations(g, scale, options);
+        Normal n = normal_equations(g, scale, options);
         if (n.inliers < 12) break;
+        add_prior(n, d.pose.R, prior, options);
         const auto delta = solve(n, options.free);
         if (!delta) break;
         ++d.iterations;
@@ -488,7 +516,8 @@ SilhouetteResult refine_by_silhouette(const model::Mesh& mesh_antenna, const Iso
 
   // Statistics and covariance at the solution (full resolution, fine search).
   const Gathered g = gather_all(m, pose, prepared, intrinsics, 0, options.fine_search_px, options);
-  const Normal n = normal_equations(g, 1.0, options);
+  Normal n = normal_equations(g, 1.0, options);
+  const double prior_weight = n.inliers > 12 ? add_prior(n, pose.R, prior, options) : 0.0;
   result.T_board_antenna.linear() = pose.R;
   result.T_board_antenna.translation() = pose.t;
   result.views_used = g.views_with_samples;
@@ -504,7 +533,10 @@ SilhouetteResult refine_by_silhouette(const model::Mesh& mesh_antenna, const Iso
     // Sandwich H⁻¹ (Σ_white + Σ_bias) H⁻¹: white edge noise (inflated for the samples' overlap),
     // plus errors shared by all samples of a mesh edge: the model's shape tolerance (the same in
     // every view) and an edge-localisation bias per view and edge (background, blur, shading).
+    // The prior counts once as information (in H) and once as its own noise (in M).
     Mat6 M = sigma2 * inflation * n.H;
+    if (prior)
+      M.topLeftCorner<3, 3>() += (prior_weight * prior_weight - sigma2 * inflation * prior_weight) * prior->information;
     std::vector<Vec6> shape(m.edges.size(), Vec6::Zero()), bias(m.edges.size(), Vec6::Zero());
     for (const auto& view : g.per_view)
       for (const auto& s : view) {

@@ -55,6 +55,9 @@ struct SilhouetteView {
   /// Crop (px) holding the antenna's whole outline plus the search range; else the start's
   /// projected bounding box + margin (the normal choice).
   std::optional<cv::Rect> roi;
+  /// Known objects nearer than the antenna (the calibration board), as image polygons (px, as
+  /// taken): outline points on them or within the search range of their border are not used.
+  std::vector<std::vector<cv::Point2f>> occluders;
 };
 
 struct SilhouetteOptions {
@@ -85,6 +88,16 @@ struct SilhouetteOptions {
   int min_views = 2;
 };
 
+/// A Gaussian prior on the rotation from another measurement (e.g. the long axis from the 3-D
+/// points): the residual is log(R_board_antenna · R⁻¹) (board frame, rad), `information` its
+/// inverse covariance (rad⁻², board frame; singular where the prior says nothing, e.g. about the
+/// long axis). It enters the Gauss–Newton steps and the covariance as one more measurement,
+/// weighted against the edges by their residual variance × the correlation inflation.
+struct RotationPrior {
+  Mat3 R_board_antenna = Mat3::Identity();
+  Mat3 information = Mat3::Zero();
+};
+
 struct SilhouetteResult {
   Iso3 T_board_antenna = Iso3::Identity();  // refined; p_board = T p_antenna
   /// (rotation vector δ in the board frame, R_true = exp(δ) R_est; translation, m).
@@ -104,6 +117,7 @@ struct SilhouetteResult {
 /// for a mesh without triangles or an image that is not CV_8UC1 of the intrinsics' size.
 SilhouetteResult refine_by_silhouette(const model::Mesh& mesh_antenna, const Iso3& T_board_antenna_initial,
                                       const std::vector<SilhouetteView>& views,
-                                      const camera::CameraIntrinsics& intrinsics, const SilhouetteOptions& options);
+                                      const camera::CameraIntrinsics& intrinsics, const SilhouetteOptions& options,
+                                      const std::optional<RotationPrior>& prior = std::nullopt);
 
 }  // namespace antpose::registration
