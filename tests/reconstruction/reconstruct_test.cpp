@@ -318,6 +318,25 @@ TEST(ReconstructRegion, DISABLED_TwelvePhotosOf12MP) {
   EXPECT_LT(t_ba + t_region, 60.0);
 }
 
+// Points inside RegionOptions::exclude_board (measure passes the calibration board's box) are
+// not the object's: none are returned there, and the rest of the object still is.
+TEST(ReconstructRegion, ExcludedBoxHoldsNoPoints) {
+  const Scene& s = textured_scene();
+  const auto all = reconstruct_region(s.views, true_poses(s), 2, test::antenna_roi(s, 2), s.K, {});
+  std::vector<double> xs;
+  for (const auto& p : all.cloud_board.points) xs.push_back(p.x());
+  std::nth_element(xs.begin(), xs.begin() + xs.size() / 2, xs.end());
+  const double cut = xs[xs.size() / 2];
+  RegionOptions o;
+  o.exclude_board = {Vec3(-1e3, -1e3, -1e3), Vec3(cut, 1e3, 1e3)};
+  const auto half = reconstruct_region(s.views, true_poses(s), 2, test::antenna_roi(s, 2), s.K, o);
+  std::size_t inside = 0;
+  for (const auto& p : half.cloud_board.points) inside += p.x() < cut - o.voxel_m;
+  EXPECT_EQ(inside, 0u);
+  EXPECT_GT(half.cloud_board.size(), all.cloud_board.size() / 4);
+  EXPECT_LT(half.cloud_board.size(), all.cloud_board.size() * 3 / 4);
+}
+
 TEST(ReconstructRegion, SkyFailsWithMessage) {
   const Scene& s = textured_scene();
   const Roi sky{150, 10, 200, 90};
