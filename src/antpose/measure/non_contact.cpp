@@ -139,35 +139,37 @@ struct Scene {
   const camera::CameraIntrinsics& intrinsics;
   std::vector<Vec3> viewpoints;  // camera centres, board frame
   Vec3 up_board;
-  std::vector<std::vector<cv::Point2f>> board_outlines;  // per view, px; empty when not in front
+  /// The photos as the outline sees them: no ROI (each start's crop follows its projection; a
+  /// carried ROI may cut the outline), the board as an occluder.
+  std::vector<registration::SilhouetteView> outline_views;
 };
 
-// The board's outline in a photo (px, as taken): its printed extent plus the white margin.
-std::vector<cv::Point2f> board_outline(const camera::BoardSpec& board, const camera::CameraIntrinsics& K,
-                                       const Mat3& R_camera_board, const Vec3& t_camera_board, double margin_m) {
+// The board as an obstacle (board frame, min and max corner): its printed extent plus the white
+// margin, and a thickness about its plane.
+std::pair<Vec3, Vec3> board_box(const camera::BoardSpec& board, const NonContactOptions& options) {
   const auto [lo, hi] = board.extent();
+  const Vec3 margin(options.board_margin_squares * board.square_m, options.board_margin_squares * board.square_m,
+                    options.board_thickness_m);
+  return {lo - margin, hi + margin};
+}
+
+// The board's outline in a photo (px, as taken), empty when a corner is behind the camera.
+std::vector<cv::Point2f> board_outline(const std::pair<Vec3, Vec3>& box, const camera::CameraIntrinsics& K,
+                                       const Mat3& R_camera_board, const Vec3& t_camera_board) {
+  const auto& [lo, hi] = box;
   std::vector<cv::Point2f> poly;
-  for (const Vec2& c : {Vec2(lo.x() - margin_m, lo.y() - margin_m), Vec2(hi.x() + margin_m, lo.y() - margin_m),
-                        Vec2(hi.x() + margin_m, hi.y() + margin_m), Vec2(lo.x() - margin_m, hi.y() + margin_m)}) {
-    const Vec3 p = R_camera_board * Vec3(c.x(), c.y(), 0.0) + t_camera_board;
-    if (p.z() <= 1e-3) return {};
-    const auto uv = K.project(p);
+  for (const Vec2& c : {Vec2(lo.x(), lo.y()), Vec2(hi.x(), lo.y()), Vec2(hi.x(), hi.y()), Vec2(lo.x(), hi.y())}) {
+    const auto uv = K.project(R_camera_board * Vec3(c.x(), c.y(), 0.0) + t_camera_board);
     if (!uv) return {};
     poly.emplace_back(static_cast<float>(uv->x()), static_cast<float>(uv->y()));
   }
   return poly;
 }
 
-// The photos as the outline sees them. No ROI: each start's crop follows its projection (a
-// carried ROI may cut the outline).
-std::vector<registration::SilhouetteView> silhouette_views(const Scene& scene) {
-  std::vector<registration::SilhouetteView> views;
-  for (std::size_t i = 0; i < scene.views.size(); ++i) {
-    const auto& v = scene.views[i];
-    views.push_back({v.image, v.R_camera_board, v.t_camera_board, {}, {}});
-    if (!scene.board_outlines[i].empty()) views.back().occluders.push_back(scene.board_outlines[i]);
-  }
-  return views;
+// R diag(variance, variance, 0) Rᵀ: a covariance (or information) on the two rotations that move
+// the antenna's long axis, none about it (R = R_board_antenna).
+Mat3 across_long_axis(const Mat3& R_board_antenna, double variance) {
+  return R_board_antenna * Vec3(variance, variance, 0.0).asDiagonal() * R_board_antenna.transpose();
 }
 
 // The silhouette stage: starts turned about the vertical from the points' pose by each start
@@ -179,13 +181,13 @@ struct SilhouettePick {
   std::optional<registration::SilhouetteResult> best;
   std::vector<Mat3> rivals;         // R_board_antenna of each rival
   bool flipped_by_outline = false;  // the outline turned the points' front/back decision
-  int converged = 0, tried = 0;
+  int tried = 0;
   std::vector<std::string> closest_failure;  // the best-scoring rejected start's reasons, when none converged
 };
 
 SilhouettePick silhouette_search(const model::AntennaModel& model, const Iso3& T_board_antenna, const Scene& scene,
                                  const NonContactOptions& options) {
-  const auto views = silhouette_views(scene);
+  const auto& views = scene.outline_views;
   SilhouettePick pick;
   std::vector<registration::SilhouetteResult> done;
   double failed_score = 2.0;
@@ -210,7 +212,6 @@ SilhouettePick silhouette_search(const model::AntennaModel& model, const Iso3& T
     else if (failed_score > r.score)
       failed_score = r.score, pick.closest_failure = r.warnings;
   }
-  pick.converged = static_cast<int>(done.size());
   if (done.empty()) return pick;
   std::sort(done.begin(), done.end(), [](const auto& a, const auto& b) { return a.score < b.score; });
   const auto is_rival = [&](const registration::SilhouetteResult& r, const registration::SilhouetteResult& best) {
@@ -262,10 +263,9 @@ std::optional<Mat3> hold_axis_to_points(AntennaMeasurement& m, Iso3& T_antenna_b
   const Mat3& R = start.linear();
   // Held: a prior far tighter than either measurement on the two rotations that move the axis.
   const double held = deg2rad(0.01);
-  registration::RotationPrior prior{R, R * Vec3(1 / (held * held), 1 / (held * held), 0).asDiagonal() * R.transpose()};
-  const auto r = registration::refine_by_silhouette(model.mesh_antenna, start, silhouette_views(scene),
-                                                    scene.intrinsics, options.silhouette_options, prior);
-  const Mat3 R_held = r.T_board_antenna.linear();
+  const registration::RotationPrior prior{R, across_long_axis(R, 1 / (held * held))};
+  const auto r = registration::refine_by_silhouette(model.mesh_antenna, start, scene.outline_views, scene.intrinsics,
+                                                    options.silhouette_options, prior);
   const double sa = deg2rad(options.points_axis_sigma_deg);
   if (r.converged) {
     m.warnings.push_back(fmt::format(
@@ -273,8 +273,7 @@ std::optional<Mat3> hold_axis_to_points(AntennaMeasurement& m, Iso3& T_antenna_b
         "sight): the points' axis is kept and the outline fixes the yaw about it",
         rad2deg(disagreement)));
     T_antenna_board = r.T_board_antenna.inverse();
-    return Mat3(r.covariance.topLeftCorner<3, 3>() +
-                R_held * Vec3(sa * sa, sa * sa, 0).asDiagonal() * R_held.transpose());
+    return Mat3(r.covariance.topLeftCorner<3, 3>() + across_long_axis(r.T_board_antenna.linear(), sa * sa));
   }
   // The outline fits only with its own axis. The points' axis is still the likelier (the
   // development sites: the points within 0.43° wherever the two disagreed, the outline 4–7° off),
@@ -284,8 +283,7 @@ std::optional<Mat3> hold_axis_to_points(AntennaMeasurement& m, Iso3& T_antenna_b
       "the points' axis is kept, and the downtilt and roll σ cover both",
       rad2deg(disagreement)));
   T_antenna_board = start.inverse();
-  const double d = disagreement / 2;
-  return Mat3(cov_outline + R * Vec3(d * d, d * d, 0).asDiagonal() * R.transpose());
+  return Mat3(cov_outline + across_long_axis(R, std::pow(disagreement / 2, 2)));
 }
 
 void register_model(AntennaMeasurement& m, const model::AntennaModel& model, const Scene& scene,
@@ -512,22 +510,19 @@ NonContactResult measure_non_contact(const Capture& capture, const NonContactSet
     }
   }
 
+  const auto board = board_box(setup.board, options);
   Scene scene{views, setup.intrinsics, {}, result.board.R_world_board.transpose() * Vec3::UnitZ(), {}};
   for (std::size_t i = 0; i < views.size(); ++i) {
-    const auto& R = result.poses.R_camera_board[i];
-    const auto& t = result.poses.t_camera_board[i];
-    scene.viewpoints.push_back(camera::camera_centre(R, t));
-    scene.board_outlines.push_back(
-        board_outline(setup.board, setup.intrinsics, R, t, options.board_margin_squares * setup.board.square_m));
+    const auto& v = views[i];
+    scene.viewpoints.push_back(camera::camera_centre(v.R_camera_board, v.t_camera_board));
+    auto& outline = scene.outline_views.emplace_back(
+        registration::SilhouetteView{v.image, v.R_camera_board, v.t_camera_board, {}, {}});
+    if (auto poly = board_outline(board, setup.intrinsics, v.R_camera_board, v.t_camera_board); !poly.empty())
+      outline.occluders.push_back(std::move(poly));
   }
   const Mat3 cov_poses = pose_rotation_covariance(result.poses);
   auto region_options = options.region;
-  {
-    const auto [lo, hi] = setup.board.extent();
-    const double margin = options.board_margin_squares * setup.board.square_m;
-    region_options.exclude_board = {lo - Vec3(margin, margin, options.board_thickness_m),
-                                    hi + Vec3(margin, margin, options.board_thickness_m)};
-  }
+  region_options.exclude_board = board;
 
   for (std::size_t k = 0; k < setup.rois.size(); ++k) {
     AntennaMeasurement m;
