@@ -72,8 +72,8 @@ struct DepthRange {
 };
 
 /// The nearest window of depths holding at least `min_support` points and a fifth of the
-/// fullest window's, shifted within its
-/// width to the position that holds most points (the cluster's centre), widened by a margin.
+/// fullest window's, shifted within its width to the position that holds most points (the
+/// cluster's centre), widened by a margin.
 /// Nearest, not densest: whatever else a rectangle drawn around an antenna holds (sky, ground,
 /// buildings, trees) lies behind the antenna, and may carry more texture than its radome.
 std::optional<DepthRange> nearest_depth_cluster(const std::vector<Vec3>& points_board, const Mat3& R, const Vec3& t,
@@ -156,13 +156,14 @@ bool inside(const Roi& r, const Vec2& p) {
   return p.x() >= r.x - 0.5 && p.y() >= r.y - 0.5 && p.x() < r.x + r.width - 0.5 && p.y() < r.y + r.height - 0.5;
 }
 
-/// The volume check shared by dense and sparse points: inside the reference ROI, within the
-/// depth range, within max_depth of every camera that might see it.
+/// Inside RegionOptions::exclude_board (the calibration board's box).
 bool excluded(const RegionOptions& o, const Vec3& p) {
   return o.exclude_board && (p.array() >= o.exclude_board->first.array()).all() &&
          (p.array() <= o.exclude_board->second.array()).all();
 }
 
+/// The volume check shared by dense and sparse points: not excluded, inside the reference ROI,
+/// within the depth range.
 bool in_volume(const DenseContext& c, const Vec3& p) {
   if (excluded(*c.options, p)) return false;
   const Mat3& R = c.poses->R_camera_board[c.roi_view];
