@@ -15,7 +15,6 @@
 #include "antpose/camera/board_pose.hpp"
 #include "antpose/io/report_text.hpp"
 #include "antpose/model/sampling.hpp"
-#include "antpose/orientation/estimator.hpp"
 
 namespace antpose::measure {
 namespace {
@@ -90,49 +89,6 @@ double extent_along(const PointCloud& cloud, const Vec3& axis) {
   return cloud.empty() ? 0.0 : hi - lo;
 }
 
-// The magnetometer around each photo (±half_window_s, in the world frame through the track)
-// against the Earth's field: WMM's at the site, else the capture's own median. A steel mast turns
-// the field's horizontal part, which moves its strength and dip too; by how much, says the
-// warning. Returns the warnings.
-std::vector<std::string> field_check(const orientation::ImuData& data, const orientation::OrientationTrack& track,
-                                     const std::vector<double>& shot_t, const std::optional<geomag::SiteField>& site,
-                                     const NonContactOptions& options) {
-  std::vector<std::string> warnings;
-  if (!data.has_magnetometer()) return warnings;
-  std::vector<double> strength, dip;
-  for (const double t : shot_t) {
-    Vec3 sum = Vec3::Zero();
-    int n = 0;
-    const auto& m = data.magnetometer;
-    for (std::size_t i = 0; i < m.size(); ++i)
-      if (std::abs(m.t[i] - t) <= options.field_half_window_s && track.contains(m.t[i]))
-        sum += track.at(m.t[i]).q_world_device * m.v[i], ++n;
-    if (n == 0) continue;
-    const Vec3 b = sum / n;
-    strength.push_back(b.norm());
-    dip.push_back(std::asin(std::clamp(-b.z() / b.norm(), -1.0, 1.0)));
-  }
-  if (strength.empty()) return warnings;
-  auto median = [](std::vector<double> v) {
-    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
-    return v[v.size() / 2];
-  };
-  const double f_ref = site ? site->elements.f_nT / 1000.0 : median(strength);
-  const double dip_ref = site ? site->inclination : median(dip);
-  double worst_f = 0.0, worst_dip = 0.0;
-  for (std::size_t i = 0; i < strength.size(); ++i) {
-    worst_f = std::max(worst_f, std::abs(strength[i] - f_ref) / f_ref);
-    worst_dip = std::max(worst_dip, std::abs(dip[i] - dip_ref));
-  }
-  if (worst_f > options.field_tolerance || worst_dip > options.dip_tolerance)
-    warnings.push_back(fmt::format(
-        "magnetic disturbance: at the photos the field differs from {} by up to {:.1f} % in strength and {:.1f}° in "
-        "dip (limits {:.0f} %, {:.1f}°): steel nearby turns the compass, and the azimuth may be off by degrees",
-        site ? "the WMM's at the site" : "its median over the photos", 100 * worst_f, rad2deg(worst_dip),
-        100 * options.field_tolerance, rad2deg(options.dip_tolerance)));
-  return warnings;
-}
-
 // What the registration of every antenna shares.
 struct Scene {
   const std::vector<PosedView>& views;
@@ -181,6 +137,9 @@ struct SilhouettePick {
   std::optional<registration::SilhouetteResult> best;
   std::vector<Mat3> rivals;         // R_board_antenna of each rival
   bool flipped_by_outline = false;  // the outline turned the points' front/back decision
+  /// The winner turned by 180° about its own long axis (front and back swapped: the same outline
+  /// but for the brackets), refined where that converged: the mount's side may choose it.
+  std::optional<registration::SilhouetteResult> turned;
   int tried = 0;
   std::vector<std::string> closest_failure;  // the best-scoring rejected start's reasons, when none converged
 };
@@ -230,16 +189,44 @@ SilhouettePick silhouette_search(const model::AntennaModel& model, const Iso3& T
   auto flipped = registration::refine_by_silhouette(model.mesh_antenna, turned, views, scene.intrinsics,
                                                     options.silhouette_options);
   ++pick.tried;
-  if (flipped.converged) {
-    if (flipped.score < pick.best->score - options.silhouette_rival_margin) {
-      pick.rivals.clear();
-      pick.best = std::move(flipped);
-      pick.flipped_by_outline = true;
-    } else if (is_rival(flipped, *pick.best)) {
-      pick.rivals.push_back(flipped.T_board_antenna.linear());
-    }
+  if (!flipped.converged) {
+    flipped = *pick.best;
+    flipped.T_board_antenna = turned;
+  } else if (flipped.score < pick.best->score - options.silhouette_rival_margin) {
+    pick.rivals.clear();
+    std::swap(flipped, *pick.best);
+    pick.flipped_by_outline = true;
+  } else if (is_rival(flipped, *pick.best)) {
+    pick.rivals.push_back(flipped.T_board_antenna.linear());
   }
+  pick.turned = std::move(flipped);
   return pick;
+}
+
+// The mount decides front and back where the outline cannot (mount_side.hpp): as registered,
+// the rivals facing the other way go; turned, the turned pose wins.
+void decide_front_by_mount(AntennaMeasurement& m, SilhouettePick& pick, const model::AntennaModel& model,
+                           const registration::PreparedCloud& model_prepared, double reach,
+                           const NonContactOptions& options) {
+  auto side = count_mount_side(m.region.cloud_board, pick.best->T_board_antenna.inverse(), model_prepared.tree,
+                               model.size_m, reach, options.mount);
+  auto verdict = mount_verdict(side, options.mount);
+  if (verdict == MountVerdict::kTurned && pick.turned) {
+    std::swap(*pick.best, *pick.turned);
+    m.warnings.push_back(fmt::format(
+        "the mount decided front and back: {} points beyond the model lay before the panel as registered and {} "
+        "behind it, so the panel is turned round (its brackets and the mast are behind it)",
+        side.before, side.behind));
+    pick.flipped_by_outline = false;
+    std::swap(side.before, side.behind);
+    verdict = MountVerdict::kAsRegistered;
+  }
+  m.mount_points = side;
+  const Vec3 boresight = pick.best->T_board_antenna.linear().col(1);
+  std::erase_if(pick.rivals, [&](const Mat3& R) {
+    return (verdict == MountVerdict::kAsRegistered && R.col(1).dot(boresight) < 0.0) ||
+           rad2deg(angle_between(R.col(1), boresight)) <= options.rival_min_deg;
+  });
 }
 
 // The points fix the panel's long axis (thousands of points along 1.3–2 m); the outline fixes the
@@ -301,7 +288,7 @@ void register_model(AntennaMeasurement& m, const model::AntennaModel& model, con
   // The outline decides the yaw where the points cannot (docs/non-contact.md).
   std::optional<Mat3> cov_silhouette;
   if (options.silhouette) {
-    const auto pick = silhouette_search(model, T_antenna_board.inverse(), scene, options);
+    auto pick = silhouette_search(model, T_antenna_board.inverse(), scene, options);
     if (!pick.best)
       // On the acceptance captures the points alone were tens of degrees off in yaw whenever the
       // outline failed: no number is better than that one.
@@ -310,6 +297,7 @@ void register_model(AntennaMeasurement& m, const model::AntennaModel& model, con
           "panel's yaw: is the whole antenna inside the photos, free of other panels in front of it, and is the "
           "model this antenna's? (closest start: {})",
           pick.tried, fmt::join(pick.closest_failure, "; ")));
+    decide_front_by_mount(m, pick, model, model_prepared, gopts.fine.max_correspondence_distance_m, options);
     T_antenna_board = pick.best->T_board_antenna.inverse();
     cov_silhouette = pick.best->covariance.topLeftCorner<3, 3>();
     m.rivals_board = pick.rivals;
@@ -501,12 +489,16 @@ NonContactResult measure_non_contact(const Capture& capture, const NonContactSet
   result.board = board_world_attitude(photos, track, setup.camera_imu, options.board_world, diagnostics);
   result.warnings.insert(result.warnings.end(), result.board.warnings.begin(), result.board.warnings.end());
   if (capture.site) result.site = geomag::site_field(geomag::MagneticModel::wmm2025(), *capture.site);
-  {
+  if (data.has_magnetometer()) {
     std::vector<double> shot_t;
     for (const auto i : result.posed) shot_t.push_back(capture.shots[i].t + setup.camera_imu.time_offset_s);
-    for (auto& w : field_check(data, track, shot_t, result.site, options)) {
+    result.field =
+        check_field(field_at_photos(data, track, shot_t, options.field.half_window_s), result.site, options.field);
+    // A disturbed compass turns the board's heading, shared by every antenna.
+    result.board.covariance(2, 2) += std::pow(result.field.heading_sigma_rad, 2);
+    for (const auto& w : result.field.warnings) {
       result.board.warnings.push_back(w);  // carried into every antenna's attitude
-      result.warnings.push_back(std::move(w));
+      result.warnings.push_back(w);
     }
   }
 
@@ -580,6 +572,19 @@ nlohmann::json to_json(const NonContactResult& r) {
                 {"view_spread_deg", r.board.view_spread_deg},
                 {"heading_sigma_deg", rad2deg(std::sqrt(r.board.covariance(2, 2)))},
                 {"tilt_sigma_deg", rad2deg(std::sqrt((r.board.covariance(0, 0) + r.board.covariance(1, 1)) / 2))}};
+  {
+    const auto& f = r.field;
+    std::vector<double> dip_deg;
+    for (const double d : f.dip_rad) dip_deg.push_back(rad2deg(d));
+    j["magnetic_field"] = {{"strength_uT", f.strength_uT},
+                           {"dip_deg", dip_deg},
+                           {"wmm_strength_uT", f.wmm_strength_uT ? nlohmann::json(*f.wmm_strength_uT) : nullptr},
+                           {"wmm_dip_deg", f.wmm_dip_rad ? nlohmann::json(rad2deg(*f.wmm_dip_rad)) : nullptr},
+                           {"strength_spread_percent", 100 * f.strength_spread_fraction},
+                           {"dip_spread_deg", rad2deg(f.dip_spread_rad)},
+                           {"disturbed", f.disturbed},
+                           {"heading_sigma_deg", rad2deg(f.heading_sigma_rad)}};
+  }
   j["world"] = "enu-magnetic";
   j["declination_deg"] = r.site ? nlohmann::json(rad2deg(r.site->declination)) : nlohmann::json(nullptr);
   j["warnings"] = r.warnings;
@@ -606,6 +611,7 @@ nlohmann::json to_json(const NonContactResult& r) {
     a["fit_rmse_m"] = ok ? nlohmann::json(m.fit_rmse_m) : nullptr;
     a["fitness"] = ok ? nlohmann::json(m.fitness) : nullptr;
     a["front_back_margin"] = m.front_back_margin ? nlohmann::json(*m.front_back_margin) : nullptr;
+    if (m.mount_points) a["mount_points"] = {{"behind", m.mount_points->behind}, {"before", m.mount_points->before}};
     a["outline_rms_px"] = m.silhouette_rms_px ? nlohmann::json(*m.silhouette_rms_px) : nullptr;
     a["photos_used"] = m.region.views_used;
     a["points"] = m.region.cloud_board.size();

@@ -28,7 +28,9 @@
 #include "antpose/io/capture.hpp"
 #include "antpose/measure/antenna_attitude.hpp"
 #include "antpose/measure/board_world.hpp"
+#include "antpose/measure/field_check.hpp"
 #include "antpose/measure/model_free.hpp"
+#include "antpose/measure/mount_side.hpp"
 #include "antpose/model/antenna_model.hpp"
 #include "antpose/reconstruction/reconstruct.hpp"
 #include "antpose/registration/global_start.hpp"
@@ -93,12 +95,7 @@ struct NonContactOptions {
     o.common_sigma_rad = Vec2(deg2rad(0.1), deg2rad(0.6));
     return o;
   }();
-  // The field at the photos against the Earth's: a calibrated magnetometer reads strength to
-  // about 1 % and dip to about 0.5°; a steel mast turning north by a few degrees moves them by
-  // more (contact mode, held still on the plate, uses 10 % and 5°).
-  double field_tolerance = 0.04;
-  double dip_tolerance = deg2rad(2.0);
-  double field_half_window_s = 0.25;
+  FieldCheckOptions field;        // magnetic disturbance (field_check.hpp)
   double model_spacing_m = 0.01;  // model surface samples
   double warn_rmse_m = 0.015;     // fit RMSE above this: poor fit warning
   double fail_rmse_m = 0.05;      // or fitness below fail_fitness: the region does not hold the model
@@ -119,6 +116,7 @@ struct NonContactOptions {
   /// Region points within this of the board's plane, inside that margin, are the board's.
   double board_thickness_m = 0.03;
   double points_axis_sigma_deg = 0.2;
+  MountSideOptions mount;  // the mount's side decides front and back (mount_side.hpp)
   int bootstrap_replicas = 40;
   double bootstrap_block_m = 0.10;
   std::uint64_t seed = 1;
@@ -142,6 +140,7 @@ struct AntennaMeasurement {
   double fitness = 0.0;                     // share of region points within reach of the model
   std::optional<double> front_back_margin;  // model registration only
   std::optional<double> silhouette_rms_px;  // the outline's edge RMS, when it decided the pose
+  std::optional<MountSide> mount_points;    // beyond the model, behind and before the panel, when counted
   reconstruction::RegionReconstruction region;
   PointCloud model_board;  // the registered model's samples, board frame (report)
   std::vector<std::string> warnings;
@@ -154,6 +153,7 @@ struct NonContactResult {
   reconstruction::RefinedPoses poses;  // of the posed shots
   BoardWorldAttitude board;
   std::optional<geomag::SiteField> site;
+  FieldCheck field;                          // the magnetometer at the photos
   std::vector<AntennaMeasurement> antennas;  // one per ROI, in order
   std::vector<std::string> warnings;         // capture-wide
 };

@@ -474,13 +474,18 @@ SilhouetteResult refine_by_silhouette(const model::Mesh& mesh_antenna, const Iso
         Normal n = normal_equations(g, scale, options);
         if (n.inliers < 12) break;
         add_prior(n, d.pose.R, prior, options);
-        const auto delta = solve(n, options.free);
+        auto delta = solve(n, options.free);
         if (!delta) break;
         ++d.iterations;
-        d.pose.R = exp_so3(delta->head<3>()) * d.pose.R;
-        d.pose.t += delta->tail<3>();
         // The step's weighted RMS image motion, in the level's px.
         const double motion = std::sqrt(std::max(0.0, delta->dot(n.H * *delta)) / n.sum_w) / scale;
+        // A trust region on the rotation: where the outline hardly fixes the yaw (a narrow
+        // panel on a coarse level, seen face-on from below) the step about the long axis can be
+        // 100°+, far beyond the linearisation, and the descent wanders from basin to basin.
+        if (const double turn = delta->head<3>().norm(); turn > options.max_step_rotation_rad)
+          *delta *= options.max_step_rotation_rad / turn;
+        d.pose.R = exp_so3(delta->head<3>()) * d.pose.R;
+        d.pose.t += delta->tail<3>();
         if (motion < 0.01) {
           d.converged = true;
           break;

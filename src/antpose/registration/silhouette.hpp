@@ -15,8 +15,10 @@
 // sample's normal a 1-D search finds the nearest strong edge (gradient along the normal, a local
 // maximum of its magnitude, ≥ half the strongest on the line; sub-pixel by a parabola); the
 // residual is the signed distance. Gauss–Newton with Tukey's biweight (scale from the MAD) solves
-// for the pose; silhouettes are re-extracted every iteration. A Gaussian pyramid (cv::pyrDown)
-// runs coarse-to-fine: wide searches on blurred images first (inner shading gone), ±4 px last.
+// for the pose, each step's rotation held within a trust region (max_step_rotation_rad: the yaw
+// about the long axis is weakly fixed and a free step can jump basins); silhouettes are
+// re-extracted every iteration. A Gaussian pyramid (cv::pyrDown) runs coarse-to-fine: wide
+// searches on blurred images first (inner shading gone), ±4 px last.
 // Scene edges not in the model (clamp arms, mast, board) are down-weighted by the robust loss.
 // Edges are searched in linear intensity (the photo's gamma undone): in encoded values a blurred
 // step's steepest point moves towards its dark side, biasing the outline's width and so the yaw.
@@ -70,6 +72,8 @@ struct SilhouetteOptions {
   int max_level = 3;                  // coarsest pyramid level allowed
   double min_coarse_width_px = 16;    // the coarsest level keeps the model's projection this wide
   int max_iterations_per_level = 12;  // Gauss–Newton steps per level and descent
+  // A step turning further is shortened to this (a trust region; see the file comment).
+  double max_step_rotation_rad = deg2rad(5.0);
   double tukey_c = 4.685;             // × robust σ (MAD), σ ≥ 0.5 px of the level
   double roi_margin_px = 40;          // around the projected model (plus 10 % of its size)
   double correlation_length_px = 12;  // covariance inflation (see the file comment)

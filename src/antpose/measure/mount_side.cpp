@@ -1,0 +1,32 @@
+#include "antpose/measure/mount_side.hpp"
+
+#include <cmath>
+
+namespace antpose::measure {
+
+MountSide count_mount_side(const PointCloud& cloud, const Iso3& T_antenna_cloud, const registration::KdTree& model,
+                           const Vec3& size_m, double reach_m, const MountSideOptions& o) {
+  MountSide side;
+  for (const auto& point : cloud.points) {
+    const Vec3 p = T_antenna_cloud * point;
+    if (std::abs(p.x()) > size_m.x() / 2 + o.lateral_margin_m || std::abs(p.z()) > size_m.z() / 2) continue;
+    const double beyond = std::abs(p.y()) - size_m.y() / 2;
+    if (beyond < o.gap_m || beyond > o.depth_m) continue;
+    std::size_t index = 0;
+    double d2 = 0.0;
+    if (model.nearest(p, index, d2) && d2 <= reach_m * reach_m) continue;
+    ++(p.y() < 0 ? side.behind : side.before);
+  }
+  return side;
+}
+
+MountVerdict mount_verdict(const MountSide& s, const MountSideOptions& o) {
+  const auto outnumbers = [&](std::size_t more, std::size_t fewer) {
+    return more >= o.min_points && static_cast<double>(more) >= o.ratio * static_cast<double>(fewer);
+  };
+  if (outnumbers(s.behind, s.before)) return MountVerdict::kAsRegistered;
+  if (outnumbers(s.before, s.behind)) return MountVerdict::kTurned;
+  return MountVerdict::kUndecided;
+}
+
+}  // namespace antpose::measure

@@ -1,0 +1,48 @@
+// Which side of a registered panel its mount is on: front and back where the outline cannot tell.
+//
+// A box's outline is the same turned by 180° about its long axis, and seen face-on the brackets
+// on the back plate hide behind the panel; the points' visibility test then has little to go on
+// (docs/non-contact.md). But a panel hangs by brackets and clamps on its back plate from a mast
+// or a wall, and its radome faces open space: the region around it holds the mount, behind it.
+// Counted are the region's points that the registered model does not explain (farther than
+// `reach_m` from it), inside the panel's outline across (plus `lateral_margin_m`) and along it,
+// between `gap_m` and `depth_m` beyond its back face or its front face.
+//
+// Verdict: at least `min_points` behind and `ratio` times as many as before: as registered; the
+// other way round: turned (the front is the back). Else undecided. On the acceptance sites
+// 701–712 the right poses had 3.6–∞ times more behind than before them (the fewest from the
+// ground, where the radome's points scatter in depth), the one wrong front/back (706-3) 9.5 times
+// more before.
+#pragma once
+
+#include <cstddef>
+
+#include "antpose/geometry/point_cloud.hpp"
+#include "antpose/registration/kdtree.hpp"
+
+namespace antpose::measure {
+
+struct MountSideOptions {
+  double gap_m = 0.03;
+  double depth_m = 0.6;  // a mast of 0.25 m radius stands ~0.3 m behind the back plate
+  double lateral_margin_m = 0.1;
+  std::size_t min_points = 50;
+  double ratio = 2.0;
+};
+
+struct MountSide {
+  std::size_t behind = 0, before = 0;  // points beyond the back face, beyond the front face
+};
+
+/// Counts of the file comment. `cloud` in any frame c, `T_antenna_cloud` the registered pose,
+/// `model_antenna` a tree over the model's surface samples (antenna frame), `size_m` its box
+/// (width along x_a, depth along y_a, height along z_a; the boresight is +y_a).
+MountSide count_mount_side(const PointCloud& cloud, const Iso3& T_antenna_cloud,
+                           const registration::KdTree& model_antenna, const Vec3& size_m, double reach_m,
+                           const MountSideOptions& options);
+
+enum class MountVerdict { kUndecided, kAsRegistered, kTurned };
+
+MountVerdict mount_verdict(const MountSide& side, const MountSideOptions& options);
+
+}  // namespace antpose::measure

@@ -1,0 +1,85 @@
+#include "antpose/measure/mount_side.hpp"
+
+#include <cmath>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "antpose/model/antenna_model.hpp"
+#include "antpose/model/sampling.hpp"
+
+namespace antpose::measure {
+namespace {
+
+constexpr double kReach = 0.03;  // the fine ICP's correspondence distance
+
+struct Site {
+  model::AntennaModel panel = model::builtin_panel("panel-2000x300x150");
+  registration::KdTree model_tree{model::sample_surface(panel.mesh_antenna, 0.01, 1).points};
+  PointCloud cloud;  // antenna frame: the radome seen from the front, the mount behind, a wall far behind
+};
+
+// Points on a vertical cylinder's half facing +y (radius r, centre (0, y0)), z within ±h/2.
+void add_mast(PointCloud& c, double y0, double r, double h, std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int i = 0; i < 3000; ++i) {
+    const double a = M_PI * u(rng);
+    c.points.emplace_back(r * std::cos(a), y0 + r * std::sin(a), h * (u(rng) - 0.5));
+  }
+}
+
+Site site(bool with_mount) {
+  Site s;
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> depth_noise(0.0, 0.008);
+  for (Vec3 p : model::visible_surface(s.panel.mesh_antenna, Vec3(0.0, 20.0, 2.0), 0.01, 2).points) {
+    p.y() += depth_noise(rng);
+    s.cloud.points.push_back(p);
+  }
+  if (with_mount) {
+    // Mast 0.25 m in radius whose face stands 0.3 m behind the back plate; two clamp arms.
+    add_mast(s.cloud, -0.075 - 0.3 - 0.25, 0.25, 1.8, rng);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    for (const double z : {-0.5, 0.5})
+      for (int i = 0; i < 300; ++i) s.cloud.points.emplace_back(0.04 * (u(rng) - 0.5), -0.15 - 0.22 * u(rng), z);
+  }
+  for (int i = 0; i < 500; ++i) s.cloud.points.emplace_back(0.0, -3.0, -1.0 + 0.004 * i);  // a wall far behind
+  return s;
+}
+
+TEST(MountSide, TheMastAndClampsLieBehindARightlyRegisteredPanel) {
+  const auto s = site(true);
+  const auto side = count_mount_side(s.cloud, Iso3::Identity(), s.model_tree, s.panel.size_m, kReach, {});
+  EXPECT_GT(side.behind, 500u);
+  EXPECT_EQ(side.before, 0u);  // the radome's own points, 8 mm deep noise, are the model's
+  EXPECT_EQ(mount_verdict(side, {}), MountVerdict::kAsRegistered);
+}
+
+TEST(MountSide, APanelRegisteredFrontToBackIsTurned) {
+  const auto s = site(true);
+  Iso3 turned = Iso3::Identity();
+  turned.linear() = Eigen::AngleAxisd(M_PI, Vec3::UnitZ()).toRotationMatrix();  // about the long axis
+  const auto side = count_mount_side(s.cloud, turned, s.model_tree, s.panel.size_m, kReach, {});
+  EXPECT_GT(side.before, 500u);
+  EXPECT_EQ(mount_verdict(side, {}), MountVerdict::kTurned);
+}
+
+TEST(MountSide, WithoutAMountInReachNothingIsDecided) {
+  const auto s = site(false);
+  const auto side = count_mount_side(s.cloud, Iso3::Identity(), s.model_tree, s.panel.size_m, kReach, {});
+  EXPECT_EQ(side.behind, 0u);  // the wall lies 3 m behind, beyond the mount's depth
+  EXPECT_EQ(side.before, 0u);
+  EXPECT_EQ(mount_verdict(side, {}), MountVerdict::kUndecided);
+}
+
+TEST(MountSide, TheVerdictNeedsEnoughPointsAndAClearRatio) {
+  const MountSideOptions o;
+  EXPECT_EQ(mount_verdict({o.min_points - 1, 0}, o), MountVerdict::kUndecided);
+  EXPECT_EQ(mount_verdict({o.min_points, 0}, o), MountVerdict::kAsRegistered);
+  EXPECT_EQ(mount_verdict({300, 200}, o), MountVerdict::kUndecided);
+  EXPECT_EQ(mount_verdict({400, 200}, o), MountVerdict::kAsRegistered);
+  EXPECT_EQ(mount_verdict({200, 400}, o), MountVerdict::kTurned);
+}
+
+}  // namespace
+}  // namespace antpose::measure
