@@ -579,7 +579,7 @@ nlohmann::json to_json(const NonContactResult& r) {
     j["magnetic_field"] = {{"strength_uT", f.strength_uT},
                            {"dip_deg", dip_deg},
                            {"wmm_strength_uT", f.wmm_strength_uT ? nlohmann::json(*f.wmm_strength_uT) : nullptr},
-                           {"wmm_dip_deg", f.wmm_dip_rad ? nlohmann::json(rad2deg(*f.wmm_dip_rad)) : nullptr},
+                           {"wmm_dip_deg", deg_or_null(f.wmm_dip_rad)},
                            {"strength_spread_percent", 100 * f.strength_spread_fraction},
                            {"dip_spread_deg", rad2deg(f.dip_spread_rad)},
                            {"disturbed", f.disturbed},

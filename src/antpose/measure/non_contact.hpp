@@ -2,9 +2,11 @@
 // calibration board in view → the antenna's azimuth, downtilt and roll in the world.
 //
 //   capture ──► board poses (PnP) ──► bundle adjustment ──► board in the world (board_world.hpp,
-//      │                                   │                  phone orientation + R_device_camera)
+//      │                                   │                  phone orientation + R_device_camera;
+//      │                                   │                  field_check.hpp: a disturbed compass)
 //      └► phone orientation track          └► per ROI: region points (board frame)
-//                                                 ──► model registration (global start + ICP)
+//                                                 ──► model registration (global start + ICP,
+//                                                     the outline, front/back by mount_side.hpp)
 //                                                     or the model-free face fit
 //                                                 ──► R_world_antenna = R_world_board R_board_antenna
 //
