@@ -264,6 +264,29 @@ TEST(Silhouette, FarStartIsNotAConfidentWrongAnswer) {
   }
 }
 
+// A descent that turns farther than max_rotation_change_rad is not accepted, but says where it
+// ended (left_start): a multi-start search descends again from there, and that second descent,
+// starting in the minimum's basin, stays put and converges.
+TEST(Silhouette, ADescentThatLeftItsBasinSaysWhereItEnded) {
+  const auto& s = scene();
+  SilhouetteOptions options;
+  options.max_rotation_change_rad = deg2rad(4.0);
+  const Iso3 start = perturbed(s.T_board_antenna, 9.0, 1.0, Vec3(0.02, -0.02, 0.02));
+  const auto r = refine_by_silhouette(s.mesh_antenna, start, s.views, s.intrinsics, options);
+  EXPECT_FALSE(r.converged);
+  ASSERT_TRUE(r.left_start.has_value());
+  EXPECT_LT(axis_errors_deg(r.left_start->linear(), s.T_board_antenna.linear()).norm(), 0.5);
+  const auto again = refine_by_silhouette(s.mesh_antenna, *r.left_start, s.views, s.intrinsics, options);
+  EXPECT_TRUE(again.converged);
+  EXPECT_FALSE(again.left_start.has_value());
+  EXPECT_LT(axis_errors_deg(again.T_board_antenna.linear(), s.T_board_antenna.linear()).norm(), 0.3);
+  // Within the limit from the start, nothing is said.
+  const auto near = refine_by_silhouette(s.mesh_antenna, perturbed(s.T_board_antenna, 2.0, 0.5, Vec3::Zero()), s.views,
+                                         s.intrinsics, options);
+  EXPECT_TRUE(near.converged);
+  EXPECT_FALSE(near.left_start.has_value());
+}
+
 TEST(Silhouette, AntennaOutsideTheViewsIsReported) {
   const auto away = make_scene(/*look_away=*/true);
   const Iso3 start = perturbed(away.T_board_antenna, 5.0, 2.0, Vec3(0.03, -0.03, 0.025));

@@ -166,6 +166,15 @@ SilhouettePick silhouette_search(const model::AntennaModel& model, const Iso3& T
     ++pick.tried;
     auto r = registration::refine_by_silhouette(model.mesh_antenna, start, views, scene.intrinsics,
                                                 options.silhouette_options);
+    // A descent that left its start's basin still ended near a minimum: descending again from
+    // there, it is kept if it stays put (then it is a minimum like any other, and the score
+    // chooses among them). Few starts sit in the right basin of a narrow panel seen face-on.
+    if (!r.converged && r.left_start) {
+      ++pick.tried;
+      auto again = registration::refine_by_silhouette(model.mesh_antenna, *r.left_start, views, scene.intrinsics,
+                                                      options.silhouette_options);
+      if (again.converged || again.score < r.score) r = std::move(again);
+    }
     if (r.converged)
       done.push_back(std::move(r));
     else if (failed_score > r.score)

@@ -587,6 +587,9 @@ SilhouetteResult refine_by_silhouette(const model::Mesh& mesh_antenna, const Iso
   }
   if (rival && rival->score < best.score) {
     ok = false;
+    result.left_start = Iso3::Identity();
+    result.left_start->linear() = rival->pose.R;
+    result.left_start->translation() = rival->pose.t;
     result.warnings.push_back(fmt::format(
         "silhouette: a pose turned {:.1f}° from the result fits the outline better (score {:.3f} vs {:.3f}) but lies "
         "more than {:.0f}° from the start: the start is probably wrong",
@@ -601,6 +604,7 @@ SilhouetteResult refine_by_silhouette(const model::Mesh& mesh_antenna, const Iso
   const double turned = rotation_distance(start.R, pose.R);
   if (turned > options.max_rotation_change_rad) {
     ok = false;
+    if (!result.left_start) result.left_start = result.T_board_antenna;
     result.warnings.push_back(fmt::format(
         "silhouette: the pose turned {:.1f}° from the start (more than {:.1f}°): probably another local minimum",
         rad2deg(turned), rad2deg(options.max_rotation_change_rad)));

@@ -113,6 +113,10 @@ struct SilhouetteResult {
   std::size_t views_used = 0, samples = 0;
   int iterations = 0;  // Gauss–Newton steps over all descents (start and rivals)
   bool converged = false;
+  /// Set when the descent left the start's basin (turned more than max_rotation_change_rad from
+  /// it, or a rival that far away scored better): the pose it reached, the better rival's if
+  /// any. Then not converged; a multi-start search may descend again from there.
+  std::optional<Iso3> left_start;
   std::vector<std::string> warnings;
 };
 
