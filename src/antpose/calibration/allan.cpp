@@ -6,6 +6,8 @@
 
 #include <fmt/format.h>
 
+#include "antpose/core/statistics.hpp"
+
 namespace antpose::calibration {
 
 std::vector<std::size_t> octave_factors(std::size_t phase_points) {
@@ -194,9 +196,7 @@ StreamAllan allan_of_stream(const Stream& stream, Diagnostics& diagnostics, cons
   out.stream = stream.name;
   std::vector<double> dt(stream.size() - 1);
   for (std::size_t i = 0; i + 1 < stream.size(); ++i) dt[i] = stream.t[i + 1] - stream.t[i];
-  std::vector<double> sorted = dt;
-  std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2), sorted.end());
-  out.tau0 = sorted[sorted.size() / 2];
+  out.tau0 = median(dt);
   std::size_t gaps = 0;
   for (double d : dt) gaps += d > 1.5 * out.tau0 ? 1 : 0;
   if (gaps > 0)

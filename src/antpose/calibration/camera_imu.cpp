@@ -15,6 +15,7 @@
 
 #include "antpose/calibration/least_squares.hpp"
 #include "antpose/camera/camera_model.hpp"
+#include "antpose/core/statistics.hpp"
 #include "antpose/orientation/gyro_integration.hpp"
 
 namespace antpose::calibration {
@@ -726,9 +727,7 @@ ReferenceFreeCalibration calibrate_reference_free(const std::vector<PhotoObserva
     chi2[k] = e.dot(fp.photo_covariance(k).ldlt().solve(e));
     angle[k] = e.norm();
   }
-  std::vector<double> sorted = chi2;
-  std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(n / 2), sorted.end());
-  const double scale = std::max(sorted[n / 2] / 2.366, 1e-12);  // median of χ²₃ is 2.366
+  const double scale = std::max(median(chi2) / 2.366, 1e-12);  // median of χ²₃ is 2.366
   std::size_t outliers = 0;
   for (std::size_t k = 0; k < n; ++k)
     if (chi2[k] / scale > options.outlier_chi2 && rad2deg(angle[k]) > options.min_outlier_deg) use[k] = false, ++outliers;

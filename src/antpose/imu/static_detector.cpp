@@ -4,6 +4,8 @@
 #include <cmath>
 #include <optional>
 
+#include "antpose/core/statistics.hpp"
+
 namespace antpose::imu {
 namespace {
 
@@ -23,10 +25,7 @@ class PrefixStats {
     }
     std::vector<double> dt;
     for (std::size_t i = 1; i < n; ++i) dt.push_back(s.t[i] - s.t[i - 1]);
-    if (!dt.empty()) {
-      std::nth_element(dt.begin(), dt.begin() + static_cast<std::ptrdiff_t>(dt.size() / 2), dt.end());
-      median_dt_ = dt[dt.size() / 2];
-    }
+    median_dt_ = median(std::move(dt));
   }
 
   struct Window {
@@ -138,8 +137,7 @@ StaticDetection detect_static(const Capture& capture, const StaticDetectorParams
       std::vector<double> v;
       v.reserve(candidates.size());
       for (const auto& c : candidates) v.push_back(c.gyro_mean[axis]);
-      std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
-      out.gyro_bias[axis] = v[v.size() / 2];
+      out.gyro_bias[axis] = median(std::move(v));
     }
     std::erase_if(candidates, [&](const Candidate& c) {
       return (c.gyro_mean - out.gyro_bias).norm() > params.gyro_rate_max;

@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 
+#include "antpose/core/statistics.hpp"
 #include "antpose/io/csv.hpp"
 #include "antpose/io/text_file.hpp"
 #include "antpose/io/time.hpp"
@@ -373,9 +374,7 @@ void validate_capture(Capture& c, const fs::path& folder, Diagnostics& diagnosti
     if (s.size() >= 3) {
       std::vector<double> dt(s.size() - 1);
       for (std::size_t i = 1; i < s.size(); ++i) dt[i - 1] = s.t[i] - s.t[i - 1];
-      std::vector<double> sorted = dt;
-      std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2), sorted.end());
-      const double median = sorted[sorted.size() / 2];
+      const double median = antpose::median(dt);
       std::size_t reported = 0;
       for (std::size_t i = 0; i < dt.size(); ++i)
         if (dt[i] > options.gap_factor * median && dt[i] > 0.05) {

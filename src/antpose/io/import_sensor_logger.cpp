@@ -9,6 +9,7 @@
 
 #include <fmt/format.h>
 
+#include "antpose/core/statistics.hpp"
 #include "antpose/io/csv.hpp"
 #include "antpose/io/import.hpp"
 #include "antpose/io/import_detail.hpp"
@@ -52,9 +53,7 @@ Table read_table(const fs::path& file, const std::vector<std::string>& columns) 
 double median_norm3(const Table& t) {
   std::vector<double> n(t.ns.size());
   for (std::size_t i = 0; i < n.size(); ++i) n[i] = std::hypot(t.values[0][i], t.values[1][i], t.values[2][i]);
-  if (n.empty()) return 0.0;
-  std::nth_element(n.begin(), n.begin() + static_cast<std::ptrdiff_t>(n.size() / 2), n.end());
-  return n[n.size() / 2];
+  return median(std::move(n));
 }
 
 // Gravity at the accelerometer's time stamps: the same rows when the stamps match (the usual

@@ -6,6 +6,8 @@
 
 #include <fmt/format.h>
 
+#include "antpose/core/statistics.hpp"
+
 namespace antpose {
 
 namespace {
@@ -27,9 +29,7 @@ StreamSummary summarize_stream(const Stream& s, double gap_factor) {
     for (double d : dt) var += (d - mean) * (d - mean);
     out.interval_std_s = std::sqrt(var / static_cast<double>(dt.size()));
     out.largest_gap_s = *std::max_element(dt.begin(), dt.end());
-    std::vector<double> sorted = dt;
-    std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2), sorted.end());
-    out.median_interval_s = sorted[sorted.size() / 2];
+    out.median_interval_s = median(dt);
     for (double d : dt)
       if (d > gap_factor * out.median_interval_s && d > 0.05) ++out.gaps;
   }

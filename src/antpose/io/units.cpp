@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 
+#include "antpose/core/statistics.hpp"
 #include "antpose/io/capture.hpp"
 
 namespace antpose::io {
@@ -13,9 +14,7 @@ namespace antpose::io {
 double median_norm(const Stream& s) {
   std::vector<double> n(s.size());
   for (std::size_t i = 0; i < s.size(); ++i) n[i] = s.xyz(i).norm();
-  if (n.empty()) return 0.0;
-  std::nth_element(n.begin(), n.begin() + n.size() / 2, n.end());
-  return n[n.size() / 2];
+  return median(std::move(n));
 }
 
 std::optional<UnitGuess> guess_accelerometer_unit(double m, const std::filesystem::path& file) {

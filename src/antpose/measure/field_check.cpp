@@ -5,13 +5,10 @@
 
 #include <fmt/format.h>
 
+#include "antpose/core/statistics.hpp"
+
 namespace antpose::measure {
 namespace {
-
-double median(std::vector<double> v) {
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
-  return v[v.size() / 2];
-}
 
 double spread(const std::vector<double>& v) {
   const auto [lo, hi] = std::minmax_element(v.begin(), v.end());

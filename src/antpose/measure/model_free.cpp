@@ -7,6 +7,8 @@
 #include <Eigen/Eigenvalues>
 #include <fmt/format.h>
 
+#include "antpose/core/statistics.hpp"
+
 namespace antpose::measure {
 namespace {
 
@@ -34,12 +36,6 @@ std::pair<Vec3, Mat3> moments(const PointCloud& cloud, const std::vector<std::si
     S += d * d.transpose();
   }
   return {c, S / static_cast<double>(idx.size())};
-}
-
-double quantile(std::vector<double> v, double q) {
-  const auto k = static_cast<std::size_t>(std::clamp(q, 0.0, 1.0) * static_cast<double>(v.size() - 1));
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
-  return v[k];
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 
 #include <fmt/format.h>
 
+#include "antpose/core/statistics.hpp"
 #include "antpose/io/csv.hpp"
 #include "antpose/io/text_file.hpp"
 #include "antpose/orientation/static_orientation.hpp"
@@ -24,13 +25,6 @@ SensorSeries copy_series(const Stream& s, const std::filesystem::path& where) {
   out.v.resize(s.size());
   for (std::size_t i = 0; i < s.size(); ++i) out.v[i] = s.xyz(i);
   return out;
-}
-
-double median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
-  std::nth_element(v.begin(), mid, v.end());
-  return *mid;
 }
 
 void check_gaps(const SensorSeries& s, const char* name, const ImuCheckOptions& o, Diagnostics& d) {

@@ -7,6 +7,7 @@
 
 #include <fmt/core.h>
 
+#include "antpose/core/statistics.hpp"
 #include "antpose/orientation/static_orientation.hpp"
 
 namespace antpose::orientation {
@@ -314,8 +315,7 @@ OrientationTrack ecompass_track(const ImuData& data, const EcompassParams& p) {
   const Prefix acc(data.accelerometer), mag(data.magnetometer);
   std::vector<double> norms(data.accelerometer.size());
   for (std::size_t i = 0; i < norms.size(); ++i) norms[i] = data.accelerometer.v[i].norm();
-  std::nth_element(norms.begin(), norms.begin() + static_cast<std::ptrdiff_t>(norms.size() / 2), norms.end());
-  const double g0 = norms[norms.size() / 2];
+  const double g0 = median(std::move(norms));
 
   OrientationTrack track;
   track.method = "ecompass";

@@ -32,6 +32,7 @@
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "antpose/core/statistics.hpp"
 #include "antpose/reconstruction/features.hpp"
 #include "antpose/reconstruction/reconstruct.hpp"
 #include "antpose/registration/global_start.hpp"
@@ -295,8 +296,7 @@ PairCloud dense_pair(const DenseContext& c, int a, int b, const std::vector<cv::
     for (int r = 1; r < H - 1; ++r)
       for (int col = N + 1; col < W - 1; ++col) v.push_back(std::abs(lap.at<float>(r, col)));
     if (!v.empty()) {
-      std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-      const double sigma = v[v.size() / 2] / 0.6745 / 6.0;
+      const double sigma = median(std::move(v)) / 0.6745 / 6.0;
       noise_var = sigma * sigma;
     }
   }

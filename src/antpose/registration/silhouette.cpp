@@ -10,6 +10,8 @@
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "antpose/core/statistics.hpp"
+
 namespace antpose::registration {
 namespace {
 
@@ -294,8 +296,7 @@ Normal normal_equations(const Gathered& g, double scale, const SilhouetteOptions
     for (const auto& s : v) abs_r.push_back(std::abs(s.r) / scale);
   n.samples = abs_r.size();
   if (abs_r.empty()) return n;
-  std::nth_element(abs_r.begin(), abs_r.begin() + abs_r.size() / 2, abs_r.end());
-  const double sigma = std::max(0.5, 1.4826 * abs_r[abs_r.size() / 2]);
+  const double sigma = std::max(0.5, 1.4826 * median(std::move(abs_r)));
   n.c = o.tukey_c * sigma * scale;
   for (const auto& v : g.per_view)
     for (const auto& s : v) {
