@@ -83,3 +83,44 @@ TEST(MountSide, TheVerdictNeedsEnoughPointsAndAClearRatio) {
 
 }  // namespace
 }  // namespace antpose::measure
+
+namespace antpose::measure {
+namespace {
+
+// A panel with downtilt t and azimuth a in a frame whose up is (0.3, −0.2, 0.93) (a board frame),
+// and its turn by 180° about its own long axis.
+struct Tilted {
+  Mat3 R, R_turned;
+  Vec3 up;
+};
+Tilted tilted(double downtilt_deg, double azimuth_deg) {
+  Tilted t;
+  t.up = Vec3(0.3, -0.2, 0.93).normalized();
+  const Mat3 R_b_world = Eigen::Quaterniond::FromTwoVectors(Vec3::UnitZ(), t.up).toRotationMatrix();
+  const Mat3 R_world_antenna = (Eigen::AngleAxisd(-deg2rad(azimuth_deg), Vec3::UnitZ()) *
+                                Eigen::AngleAxisd(-deg2rad(downtilt_deg), Vec3::UnitX()))
+                                   .toRotationMatrix();
+  t.R = R_b_world * R_world_antenna;
+  t.R_turned = t.R * Eigen::AngleAxisd(M_PI, Vec3::UnitZ()).toRotationMatrix();
+  return t;
+}
+
+TEST(MountSide, DowntiltOfTheBoresight) {
+  const auto t = tilted(7.0, 123.0);
+  EXPECT_NEAR(rad2deg(boresight_downtilt(t.R, t.up)), 7.0, 1e-9);
+  EXPECT_NEAR(rad2deg(boresight_downtilt(t.R_turned, t.up)), -7.0, 1e-9);  // turned round: the sign flips
+}
+
+TEST(MountSide, DowntiltSignDecidesFrontAndBackBeyondTheUptiltLimit) {
+  const double limit = deg2rad(3.0);
+  const auto down = tilted(8.0, 40.0);
+  EXPECT_EQ(downtilt_verdict(down.R, down.R_turned, down.up, limit), MountVerdict::kAsRegistered);
+  EXPECT_EQ(downtilt_verdict(down.R_turned, down.R, down.up, limit), MountVerdict::kTurned);
+  // Within the limit either way (a panel 2° down could be one 2° up): no decision.
+  const auto flat = tilted(2.0, 40.0);
+  EXPECT_EQ(downtilt_verdict(flat.R, flat.R_turned, flat.up, limit), MountVerdict::kUndecided);
+  EXPECT_EQ(downtilt_verdict(flat.R_turned, flat.R, flat.up, limit), MountVerdict::kUndecided);
+}
+
+}  // namespace
+}  // namespace antpose::measure

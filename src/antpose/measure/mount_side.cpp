@@ -1,5 +1,6 @@
 #include "antpose/measure/mount_side.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace antpose::measure {
@@ -26,6 +27,17 @@ MountVerdict mount_verdict(const MountSide& s, const MountSideOptions& o) {
   };
   if (outnumbers(s.behind, s.before)) return MountVerdict::kAsRegistered;
   if (outnumbers(s.before, s.behind)) return MountVerdict::kTurned;
+  return MountVerdict::kUndecided;
+}
+
+double boresight_downtilt(const Mat3& R, const Vec3& up) {
+  return -std::asin(std::clamp(R.col(1).dot(up.normalized()), -1.0, 1.0));
+}
+
+MountVerdict downtilt_verdict(const Mat3& R, const Mat3& R_turned, const Vec3& up, double max_uptilt) {
+  const double as_registered = boresight_downtilt(R, up), turned = boresight_downtilt(R_turned, up);
+  if (as_registered > max_uptilt && turned < -max_uptilt) return MountVerdict::kAsRegistered;
+  if (as_registered < -max_uptilt && turned > max_uptilt) return MountVerdict::kTurned;
   return MountVerdict::kUndecided;
 }
 

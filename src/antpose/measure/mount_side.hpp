@@ -45,4 +45,15 @@ enum class MountVerdict { kUndecided, kAsRegistered, kTurned };
 
 MountVerdict mount_verdict(const MountSide& side, const MountSideOptions& options);
 
+/// Front and back by the downtilt's sign, for when the mount cannot tell (seen face-on, the
+/// mast hides behind the panel): turned by 180° about its long axis a panel's downtilt changes
+/// sign, and mounts tilt panels down (tilt kits 0–15°), not up. With `R_board_antenna` as
+/// registered and `R_turned` its turn (any frame b with `up_b` the upward vertical): as
+/// registered when it tilts down and the turn up by more than `max_uptilt_rad`, turned the other
+/// way round, else undecided.
+MountVerdict downtilt_verdict(const Mat3& R_b_antenna, const Mat3& R_b_turned, const Vec3& up_b, double max_uptilt_rad);
+
+/// Downtilt (rad, positive down) of the boresight y_a of R_b_antenna, `up_b` the upward vertical.
+double boresight_downtilt(const Mat3& R_b_antenna, const Vec3& up_b);
+
 }  // namespace antpose::measure

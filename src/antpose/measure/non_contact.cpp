@@ -212,10 +212,11 @@ SilhouettePick silhouette_search(const model::AntennaModel& model, const Iso3& T
   return pick;
 }
 
-// The mount decides front and back where the outline cannot (mount_side.hpp): as registered,
-// the rivals facing the other way go; turned, the turned pose wins.
+// The mount decides front and back where the outline cannot (mount_side.hpp), and the
+// downtilt's sign where the mount cannot (options.max_uptilt_deg): as registered, the rivals
+// facing the other way go; turned, the turned pose wins.
 void decide_front_by_mount(AntennaMeasurement& m, SilhouettePick& pick, const model::AntennaModel& model,
-                           const registration::PreparedCloud& model_prepared, double reach,
+                           const registration::PreparedCloud& model_prepared, double reach, const Vec3& up_board,
                            const NonContactOptions& options) {
   auto side = count_mount_side(m.region.cloud_board, pick.best->T_board_antenna.inverse(), model_prepared.tree,
                                model.size_m, reach, options.mount);
@@ -229,6 +230,22 @@ void decide_front_by_mount(AntennaMeasurement& m, SilhouettePick& pick, const mo
     pick.flipped_by_outline = false;
     std::swap(side.before, side.behind);
     verdict = MountVerdict::kAsRegistered;
+  }
+  // Undecided (seen face-on, the mast hides behind the panel): the downtilt's sign.
+  if (verdict == MountVerdict::kUndecided && pick.turned) {
+    const Mat3& R = pick.best->T_board_antenna.linear();
+    const Mat3& R_turned = pick.turned->T_board_antenna.linear();
+    verdict = downtilt_verdict(R, R_turned, up_board, deg2rad(options.max_uptilt_deg));
+    if (verdict == MountVerdict::kTurned) {
+      m.warnings.push_back(fmt::format(
+          "front and back decided by the downtilt's sign: as registered the panel would tilt up by {:.1f}°; "
+          "turned round it tilts down by {:.1f}°",
+          -rad2deg(boresight_downtilt(R, up_board)), rad2deg(boresight_downtilt(R_turned, up_board))));
+      std::swap(*pick.best, *pick.turned);
+      pick.flipped_by_outline = false;
+      std::swap(side.before, side.behind);
+      verdict = MountVerdict::kAsRegistered;
+    }
   }
   m.mount_points = side;
   const Vec3 boresight = pick.best->T_board_antenna.linear().col(1);
@@ -306,7 +323,8 @@ void register_model(AntennaMeasurement& m, const model::AntennaModel& model, con
           "panel's yaw: is the whole antenna inside the photos, free of other panels in front of it, and is the "
           "model this antenna's? (closest start: {})",
           pick.tried, fmt::join(pick.closest_failure, "; ")));
-    decide_front_by_mount(m, pick, model, model_prepared, gopts.fine.max_correspondence_distance_m, options);
+    decide_front_by_mount(m, pick, model, model_prepared, gopts.fine.max_correspondence_distance_m, scene.up_board,
+                          options);
     T_antenna_board = pick.best->T_board_antenna.inverse();
     cov_silhouette = pick.best->covariance.topLeftCorner<3, 3>();
     m.rivals_board = pick.rivals;

@@ -120,6 +120,10 @@ struct NonContactOptions {
   double board_thickness_m = 0.03;
   double points_axis_sigma_deg = 0.2;
   MountSideOptions mount;  // the mount's side decides front and back (mount_side.hpp)
+  /// Where the mount's side cannot tell front from back, the downtilt's sign does: turning a
+  /// panel round negates its downtilt, and mounts tilt panels down (tilt kits 0–15°), not up by
+  /// more than this.
+  double max_uptilt_deg = 3.0;
   int bootstrap_replicas = 40;
   double bootstrap_block_m = 0.10;
   std::uint64_t seed = 1;
