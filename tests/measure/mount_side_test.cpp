@@ -81,12 +81,6 @@ TEST(MountSide, TheVerdictNeedsEnoughPointsAndAClearRatio) {
   EXPECT_EQ(mount_verdict({200, 400}, o), MountVerdict::kTurned);
 }
 
-}  // namespace
-}  // namespace antpose::measure
-
-namespace antpose::measure {
-namespace {
-
 // A panel with downtilt t and azimuth a in a frame whose up is (0.3, −0.2, 0.93) (a board frame),
 // and its turn by 180° about its own long axis.
 struct Tilted {
@@ -111,15 +105,44 @@ TEST(MountSide, DowntiltOfTheBoresight) {
   EXPECT_NEAR(rad2deg(boresight_downtilt(t.R_turned, t.up)), -7.0, 1e-9);  // turned round: the sign flips
 }
 
-TEST(MountSide, DowntiltSignDecidesFrontAndBackBeyondTheUptiltLimit) {
+TEST(MountSide, WithoutTheMountTheDowntiltsSignDecidesBeyondTheUptiltLimit) {
   const double limit = deg2rad(3.0);
+  const auto call = [&](const Tilted& t, bool turned) {
+    const double a = boresight_downtilt(t.R, t.up), b = boresight_downtilt(t.R_turned, t.up);
+    return turned ? decide_front_back(MountVerdict::kUndecided, b, a, limit)
+                  : decide_front_back(MountVerdict::kUndecided, a, b, limit);
+  };
   const auto down = tilted(8.0, 40.0);
-  EXPECT_EQ(downtilt_verdict(down.R, down.R_turned, down.up, limit), MountVerdict::kAsRegistered);
-  EXPECT_EQ(downtilt_verdict(down.R_turned, down.R, down.up, limit), MountVerdict::kTurned);
+  EXPECT_EQ(call(down, false).verdict, MountVerdict::kAsRegistered);
+  EXPECT_EQ(call(down, true).verdict, MountVerdict::kTurned);
+  EXPECT_TRUE(call(down, true).by_downtilt);
   // Within the limit either way (a panel 2° down could be one 2° up): no decision.
   const auto flat = tilted(2.0, 40.0);
-  EXPECT_EQ(downtilt_verdict(flat.R, flat.R_turned, flat.up, limit), MountVerdict::kUndecided);
-  EXPECT_EQ(downtilt_verdict(flat.R_turned, flat.R, flat.up, limit), MountVerdict::kUndecided);
+  for (const bool turned : {false, true}) {
+    EXPECT_EQ(call(flat, turned).verdict, MountVerdict::kUndecided);
+    EXPECT_FALSE(call(flat, turned).by_downtilt || call(flat, turned).in_doubt);
+  }
+}
+
+TEST(MountSide, TheMountDecidesUnlessItWouldTiltThePanelUp) {
+  const double limit = deg2rad(3.0), down = deg2rad(8.0), flat = deg2rad(1.0);
+  // The mount agrees with the downtilt, or the downtilt cannot tell: the mount's verdict.
+  for (const double tilt : {down, flat, -flat}) {
+    const auto kept = decide_front_back(MountVerdict::kAsRegistered, tilt, -tilt, limit);
+    EXPECT_EQ(kept.verdict, MountVerdict::kAsRegistered);
+    EXPECT_FALSE(kept.in_doubt || kept.by_downtilt);
+    const auto turned = decide_front_back(MountVerdict::kTurned, -tilt, tilt, limit);
+    EXPECT_EQ(turned.verdict, MountVerdict::kTurned);
+    EXPECT_FALSE(turned.in_doubt || turned.by_downtilt);
+  }
+  // The mount's choice tilts the panel up by 8° (site 1004-1: 114 points before the panel turned
+  // a right pose): the cues disagree, nothing is decided, and the caller keeps both.
+  const auto against_registered = decide_front_back(MountVerdict::kAsRegistered, -down, down, limit);
+  EXPECT_EQ(against_registered.verdict, MountVerdict::kUndecided);
+  EXPECT_TRUE(against_registered.in_doubt);
+  const auto against_turned = decide_front_back(MountVerdict::kTurned, down, -down, limit);
+  EXPECT_EQ(against_turned.verdict, MountVerdict::kUndecided);
+  EXPECT_TRUE(against_turned.in_doubt);
 }
 
 }  // namespace

@@ -287,6 +287,25 @@ TEST(Silhouette, ADescentThatLeftItsBasinSaysWhereItEnded) {
   EXPECT_FALSE(near.left_start.has_value());
 }
 
+// Steps that swing back and forth below swing_motion_px have arrived (see silhouette.cpp): the
+// rule ends descents sooner and lands where the strict 0.01 px criterion does.
+TEST(Silhouette, ASwingingDescentHasArrived) {
+  const auto& s = scene();
+  const Iso3 start = perturbed(s.T_board_antenna, 5.0, 2.0, Vec3(0.03, -0.03, 0.025));
+  SilhouetteOptions strict;
+  strict.swing_motion_px = 0.0;
+  strict.max_iterations_per_level = 40;
+  const auto a = refine_by_silhouette(s.mesh_antenna, start, s.views, s.intrinsics, strict);
+  const auto b = refine_by_silhouette(s.mesh_antenna, start, s.views, s.intrinsics, {});
+  std::printf("iterations strict %d, with the swing rule %d\n", a.iterations, b.iterations);
+  ASSERT_TRUE(a.converged);
+  ASSERT_TRUE(b.converged);
+  EXPECT_LE(b.iterations, a.iterations);
+  const Vec3 apart = axis_errors_deg(b.T_board_antenna.linear(), a.T_board_antenna.linear());
+  EXPECT_LT(apart.cwiseAbs().maxCoeff(), 0.05);
+  EXPECT_LT((b.T_board_antenna.translation() - a.T_board_antenna.translation()).norm(), 1e-3);
+}
+
 TEST(Silhouette, AntennaOutsideTheViewsIsReported) {
   const auto away = make_scene(/*look_away=*/true);
   const Iso3 start = perturbed(away.T_board_antenna, 5.0, 2.0, Vec3(0.03, -0.03, 0.025));

@@ -34,11 +34,29 @@ double boresight_downtilt(const Mat3& R, const Vec3& up) {
   return -std::asin(std::clamp(R.col(1).dot(up.normalized()), -1.0, 1.0));
 }
 
-MountVerdict downtilt_verdict(const Mat3& R, const Mat3& R_turned, const Vec3& up, double max_uptilt) {
-  const double as_registered = boresight_downtilt(R, up), turned = boresight_downtilt(R_turned, up);
+namespace {
+
+MountVerdict by_downtilt(double as_registered, double turned, double max_uptilt) {
   if (as_registered > max_uptilt && turned < -max_uptilt) return MountVerdict::kAsRegistered;
   if (as_registered < -max_uptilt && turned > max_uptilt) return MountVerdict::kTurned;
   return MountVerdict::kUndecided;
+}
+
+}  // namespace
+
+FrontBack decide_front_back(MountVerdict mount, double downtilt_registered, double downtilt_turned, double max_uptilt) {
+  switch (mount) {
+    case MountVerdict::kAsRegistered:
+      if (downtilt_registered < -max_uptilt) return {MountVerdict::kUndecided, false, true};
+      return {mount, false, false};
+    case MountVerdict::kTurned:
+      if (downtilt_turned < -max_uptilt) return {MountVerdict::kUndecided, false, true};
+      return {mount, false, false};
+    case MountVerdict::kUndecided:
+      break;
+  }
+  const auto verdict = by_downtilt(downtilt_registered, downtilt_turned, max_uptilt);
+  return {verdict, verdict != MountVerdict::kUndecided, false};
 }
 
 }  // namespace antpose::measure

@@ -45,13 +45,19 @@ enum class MountVerdict { kUndecided, kAsRegistered, kTurned };
 
 MountVerdict mount_verdict(const MountSide& side, const MountSideOptions& options);
 
-/// Front and back by the downtilt's sign, for when the mount cannot tell (seen face-on, the
-/// mast hides behind the panel): turned by 180° about its long axis a panel's downtilt changes
-/// sign, and mounts tilt panels down (tilt kits 0–15°), not up. With `R_board_antenna` as
-/// registered and `R_turned` its turn (any frame b with `up_b` the upward vertical): as
-/// registered when it tilts down and the turn up by more than `max_uptilt_rad`, turned the other
-/// way round, else undecided.
-MountVerdict downtilt_verdict(const Mat3& R_b_antenna, const Mat3& R_b_turned, const Vec3& up_b, double max_uptilt_rad);
+/// Front and back from both cues. The mount's verdict where it has one. Else the downtilt's sign
+/// (the mast hides behind a panel seen face-on): turned by 180° about its long axis a panel's
+/// downtilt changes sign, and mounts tilt panels down (tilt kits 0–15°), not up: as registered
+/// when it tilts down and the turn up by more than `max_uptilt_rad`, turned the other way round
+/// (`by_downtilt`). Where the mount's choice tilts the panel up by more than that the cues
+/// disagree: undecided and `in_doubt` (the other way round stays possible). Downtilts in rad,
+/// positive down, of the pose as registered and turned round (boresight_downtilt).
+struct FrontBack {
+  MountVerdict verdict = MountVerdict::kUndecided;
+  bool by_downtilt = false, in_doubt = false;
+};
+FrontBack decide_front_back(MountVerdict mount, double downtilt_registered, double downtilt_turned,
+                            double max_uptilt_rad);
 
 /// Downtilt (rad, positive down) of the boresight y_a of R_b_antenna, `up_b` the upward vertical.
 double boresight_downtilt(const Mat3& R_b_antenna, const Vec3& up_b);

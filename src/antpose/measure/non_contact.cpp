@@ -175,6 +175,11 @@ SilhouettePick silhouette_search(const model::AntennaModel& model, const Iso3& T
                                                       options.silhouette_options);
       if (again.converged || again.score < r.score) r = std::move(again);
     }
+    if (r.converged && r.score > options.silhouette_max_score) {
+      r.converged = false;
+      r.warnings.push_back(
+          fmt::format("the outline fits poorly: score {:.2f} (at most {:.2f})", r.score, options.silhouette_max_score));
+    }
     if (r.converged)
       done.push_back(std::move(r));
     else if (failed_score > r.score)
@@ -212,67 +217,99 @@ SilhouettePick silhouette_search(const model::AntennaModel& model, const Iso3& T
   return pick;
 }
 
+// The points' long axis (board frame, pointing as R_board_antenna's z): ICP from T_antenna_board.
+// Thousands of points along 1.3–2 m fix it where the outline may slide (hold_axis_to_points).
+Vec3 points_long_axis(const registration::PreparedCloud& cloud, const registration::PreparedCloud& model_prepared,
+                      const Iso3& T_antenna_board, const NonContactOptions& options) {
+  const auto icp = registration::align(cloud, model_prepared, T_antenna_board, options.registration.fine);
+  const Vec3 axis = icp.T_target_source.rotation().transpose().col(2);
+  return axis.dot(T_antenna_board.rotation().row(2).transpose()) < 0.0 ? Vec3(-axis) : axis;
+}
+
+// R_board_antenna turned the shortest way to put its long axis on `axis_board`.
+Mat3 with_long_axis(const Mat3& R_board_antenna, const Vec3& axis_board) {
+  return Eigen::Quaterniond::FromTwoVectors(R_board_antenna.col(2), axis_board).toRotationMatrix() * R_board_antenna;
+}
+
 // The mount decides front and back where the outline cannot (mount_side.hpp), and the
 // downtilt's sign where the mount cannot (options.max_uptilt_deg): as registered, the rivals
-// facing the other way go; turned, the turned pose wins.
+// facing the other way go; turned, the turned pose wins. Where the mount's choice would tilt the
+// panel up beyond that limit the two disagree, and the other way round stays a rival. The
+// downtilt is read with the long axis the measurement keeps (the points' beyond the axis gate).
 void decide_front_by_mount(AntennaMeasurement& m, SilhouettePick& pick, const model::AntennaModel& model,
-                           const registration::PreparedCloud& model_prepared, double reach, const Vec3& up_board,
-                           const NonContactOptions& options) {
+                           const registration::PreparedCloud& model_prepared, const Vec3& axis_points, double reach,
+                           const Vec3& up_board, const NonContactOptions& options) {
   auto side = count_mount_side(m.region.cloud_board, pick.best->T_board_antenna.inverse(), model_prepared.tree,
                                model.size_m, reach, options.mount);
-  auto verdict = mount_verdict(side, options.mount);
-  if (verdict == MountVerdict::kTurned && pick.turned) {
+  const auto downtilt = [&](const registration::SilhouetteResult& r) {
+    const Mat3& R = r.T_board_antenna.linear();
+    const bool off_axis = rad2deg(angle_between(R.col(2), axis_points)) > options.axis_gate_deg;
+    return boresight_downtilt(off_axis ? with_long_axis(R, axis_points) : R, up_board);
+  };
+  const double tilt = downtilt(*pick.best), tilt_turned = pick.turned ? downtilt(*pick.turned) : -tilt;
+  const FrontBack call =
+      decide_front_back(mount_verdict(side, options.mount), tilt, tilt_turned, deg2rad(options.max_uptilt_deg));
+  if (call.verdict == MountVerdict::kTurned && pick.turned) {
+    m.warnings.push_back(
+        call.by_downtilt
+            ? fmt::format("front and back decided by the downtilt's sign: as registered the panel would tilt up by "
+                          "{:.1f}°; turned round it tilts down by {:.1f}°",
+                          -rad2deg(tilt), rad2deg(tilt_turned))
+            : fmt::format("the mount decided front and back: {} points beyond the model lay before the panel as "
+                          "registered and {} behind it, so the panel is turned round (its brackets and the mast are "
+                          "behind it)",
+                          side.before, side.behind));
     std::swap(*pick.best, *pick.turned);
-    m.warnings.push_back(fmt::format(
-        "the mount decided front and back: {} points beyond the model lay before the panel as registered and {} "
-        "behind it, so the panel is turned round (its brackets and the mast are behind it)",
-        side.before, side.behind));
     pick.flipped_by_outline = false;
     std::swap(side.before, side.behind);
-    verdict = MountVerdict::kAsRegistered;
   }
-  // Undecided (seen face-on, the mast hides behind the panel): the downtilt's sign.
-  if (verdict == MountVerdict::kUndecided && pick.turned) {
-    const Mat3& R = pick.best->T_board_antenna.linear();
-    const Mat3& R_turned = pick.turned->T_board_antenna.linear();
-    verdict = downtilt_verdict(R, R_turned, up_board, deg2rad(options.max_uptilt_deg));
-    if (verdict == MountVerdict::kTurned) {
-      m.warnings.push_back(fmt::format(
-          "front and back decided by the downtilt's sign: as registered the panel would tilt up by {:.1f}°; "
-          "turned round it tilts down by {:.1f}°",
-          -rad2deg(boresight_downtilt(R, up_board)), rad2deg(boresight_downtilt(R_turned, up_board))));
+  // In doubt the pose that tilts down is reported, the mount's the rival its σ covers.
+  if (call.in_doubt && pick.turned) {
+    const bool mount_turns = mount_verdict(side, options.mount) == MountVerdict::kTurned;
+    m.warnings.push_back(fmt::format(
+        "front and back are in doubt: the mount ({} points behind the panel, {} before it) puts the front where the "
+        "panel tilts up by {:.1f}°, and mounts tilt panels down; the σ covers the panel turned round",
+        mount_turns ? side.before : side.behind, mount_turns ? side.behind : side.before,
+        -rad2deg(mount_turns ? tilt_turned : tilt)));
+    if (!mount_turns) {
       std::swap(*pick.best, *pick.turned);
       pick.flipped_by_outline = false;
       std::swap(side.before, side.behind);
-      verdict = MountVerdict::kAsRegistered;
     }
+    pick.rivals.push_back(pick.turned->T_board_antenna.linear());
   }
   m.mount_points = side;
+  const bool decided = call.verdict != MountVerdict::kUndecided;
   const Vec3 boresight = pick.best->T_board_antenna.linear().col(1);
   std::erase_if(pick.rivals, [&](const Mat3& R) {
-    return (verdict == MountVerdict::kAsRegistered && R.col(1).dot(boresight) < 0.0) ||
+    return (decided && R.col(1).dot(boresight) < 0.0) ||
            rad2deg(angle_between(R.col(1), boresight)) <= options.rival_min_deg;
   });
+  // One rival per place: starts that ended together would each widen the σ again.
+  std::vector<Mat3> distinct;
+  for (const Mat3& R : pick.rivals)
+    if (std::none_of(distinct.begin(), distinct.end(), [&](const Mat3& D) {
+          return rad2deg(angle_between(R.col(1), D.col(1))) <= options.rival_min_deg;
+        }))
+      distinct.push_back(R);
+  pick.rivals = std::move(distinct);
 }
 
 // The points fix the panel's long axis (thousands of points along 1.3–2 m); the outline fixes the
 // yaw about it. Seen from below, the outline may instead slide in tilt along the line of sight
-// (the mast's and the clamps' edges beside it fit as well): when the points' axis, refined from
-// the outline's pose, lies more than options.axis_gate_deg away, the outline is refined again
+// (the mast's and the clamps' edges beside it fit as well): when the points' axis
+// (points_long_axis) lies more than options.axis_gate_deg away, the outline is refined again
 // with the axis held to the points' and only the yaw and position free. Returns the rotation
 // covariance (board frame) to use, or nothing when the outline's own stands.
 std::optional<Mat3> hold_axis_to_points(AntennaMeasurement& m, Iso3& T_antenna_board, const Mat3& cov_outline,
-                                        const model::AntennaModel& model, const registration::PreparedCloud& cloud,
-                                        const registration::PreparedCloud& model_prepared, const Scene& scene,
+                                        const model::AntennaModel& model, const Vec3& axis_points, const Scene& scene,
                                         const NonContactOptions& options) {
-  const auto icp = registration::align(cloud, model_prepared, T_antenna_board, options.registration.fine);
   const Mat3 R_outline = T_antenna_board.rotation().transpose();
-  const Vec3 axis_points = icp.T_target_source.rotation().transpose().col(2);
   const double disagreement = angle_between(R_outline.col(2), axis_points);
   if (rad2deg(disagreement) <= options.axis_gate_deg) return std::nullopt;
 
   Iso3 start = T_antenna_board.inverse();
-  start.linear() = Eigen::Quaterniond::FromTwoVectors(R_outline.col(2), axis_points).toRotationMatrix() * R_outline;
+  start.linear() = with_long_axis(R_outline, axis_points);
   const Mat3& R = start.linear();
   // Held: a prior far tighter than either measurement on the two rotations that move the axis.
   const double held = deg2rad(0.01);
@@ -323,8 +360,9 @@ void register_model(AntennaMeasurement& m, const model::AntennaModel& model, con
           "panel's yaw: is the whole antenna inside the photos, free of other panels in front of it, and is the "
           "model this antenna's? (closest start: {})",
           pick.tried, fmt::join(pick.closest_failure, "; ")));
-    decide_front_by_mount(m, pick, model, model_prepared, gopts.fine.max_correspondence_distance_m, scene.up_board,
-                          options);
+    const Vec3 axis_points = points_long_axis(cloud, model_prepared, pick.best->T_board_antenna.inverse(), options);
+    decide_front_by_mount(m, pick, model, model_prepared, axis_points, gopts.fine.max_correspondence_distance_m,
+                          scene.up_board, options);
     T_antenna_board = pick.best->T_board_antenna.inverse();
     cov_silhouette = pick.best->covariance.topLeftCorner<3, 3>();
     m.rivals_board = pick.rivals;
@@ -335,8 +373,7 @@ void register_model(AntennaMeasurement& m, const model::AntennaModel& model, con
       m.warnings.push_back(
           "the outline turned the points' front/back decision (the brackets' outline fits "
           "clearly better the other way round)");
-    if (const auto held =
-            hold_axis_to_points(m, T_antenna_board, *cov_silhouette, model, cloud, model_prepared, scene, options))
+    if (const auto held = hold_axis_to_points(m, T_antenna_board, *cov_silhouette, model, axis_points, scene, options))
       cov_silhouette = held;
   }
   m.R_board_antenna = T_antenna_board.rotation().transpose();

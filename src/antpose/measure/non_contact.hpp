@@ -80,6 +80,11 @@ struct NonContactOptions {
   bool silhouette = true;
   std::vector<double> silhouette_yaw_starts_deg = {0, 25, -25, 50, -50, 75, -75};
   double silhouette_rival_margin = 0.02;  // a converged start within this score is a rival
+  /// A converged start whose score (the outline's mean truncated edge cost, 0 .. 1) is above this
+  /// fits too little of the outline to be trusted. On the development sites 601–912 and 1008
+  /// the right poses scored 0.013–0.351, the confidently wrong ones (606-3 65°, 610-1 28°,
+  /// 1008-1 130° off) 0.466–0.562.
+  double silhouette_max_score = 0.4;
   /// The starts already span the yaws: the refinement's own mirror restarts are left out.
   registration::SilhouetteOptions silhouette_options = [] {
     registration::SilhouetteOptions o;

@@ -470,6 +470,7 @@ SilhouetteResult refine_by_silhouette(const model::Mesh& mesh_antenna, const Iso
       const double search =
           level == top ? std::max(options.fine_search_px, options.search_range_px / scale) : options.fine_search_px;
       d.converged = false;
+      Vec6 previous_step = Vec6::Zero();
       for (int it = 0; it < options.max_iterations_per_level; ++it) {
         const Gathered g = gather_all(m, d.pose, prepared, intrinsics, level, search, options);
         Normal n = normal_equations(g, scale, options);
@@ -485,9 +486,16 @@ SilhouetteResult refine_by_silhouette(const model::Mesh& mesh_antenna, const Iso
         // 100°+, far beyond the linearisation, and the descent wanders from basin to basin.
         if (const double turn = delta->head<3>().norm(); turn > options.max_step_rotation_rad)
           *delta *= options.max_step_rotation_rad / turn;
+        // Where the outline hardly fixes a direction (the yaw of a narrow panel seen face-on),
+        // samples entering and leaving the robust weights make the steps swing back and forth
+        // about the minimum without shrinking: a small step reversing the last one has arrived,
+        // and half of it lands between the two poses.
+        const bool swinging = motion < options.swing_motion_px && delta->dot(n.H * previous_step) < 0.0;
+        if (swinging) *delta /= 2;
         d.pose.R = exp_so3(delta->head<3>()) * d.pose.R;
         d.pose.t += delta->tail<3>();
-        if (motion < 0.01) {
+        previous_step = *delta;
+        if (motion < 0.01 || swinging) {
           d.converged = true;
           break;
         }

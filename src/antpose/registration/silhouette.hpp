@@ -71,7 +71,8 @@ struct SilhouetteOptions {
   double gamma = 2.2;                 // photo encoding undone before edge search (sRGB ≈ 2.2); 0: as stored
   int max_level = 3;                  // coarsest pyramid level allowed
   double min_coarse_width_px = 16;    // the coarsest level keeps the model's projection this wide
-  int max_iterations_per_level = 12;  // Gauss–Newton steps per level and descent
+  int max_iterations_per_level = 12;  // Gauss–Newton steps per level and descent; done below 0.01 px
+  double swing_motion_px = 0.05;      // or below this when a step reverses the last (see the .cpp)
   // A step turning further is shortened to this (a trust region; see the file comment).
   double max_step_rotation_rad = deg2rad(5.0);
   double tukey_c = 4.685;             // × robust σ (MAD), σ ≥ 0.5 px of the level
