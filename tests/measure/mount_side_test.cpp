@@ -79,6 +79,10 @@ TEST(MountSide, TheVerdictNeedsEnoughPointsAndAClearRatio) {
   EXPECT_EQ(mount_verdict({300, 200}, o), MountVerdict::kUndecided);
   EXPECT_EQ(mount_verdict({400, 200}, o), MountVerdict::kAsRegistered);
   EXPECT_EQ(mount_verdict({200, 400}, o), MountVerdict::kTurned);
+  // Turning a pose round takes more points than keeping it (1004-1: 114 turned a right pose).
+  EXPECT_EQ(mount_verdict({0, o.min_points_to_turn - 1}, o), MountVerdict::kUndecided);
+  EXPECT_EQ(mount_verdict({0, o.min_points_to_turn}, o), MountVerdict::kTurned);
+  EXPECT_EQ(mount_verdict({o.min_points_to_turn - 1, 0}, o), MountVerdict::kAsRegistered);
 }
 
 // A panel with downtilt t and azimuth a in a frame whose up is (0.3, −0.2, 0.93) (a board frame),

@@ -22,11 +22,11 @@ MountSide count_mount_side(const PointCloud& cloud, const Iso3& T_antenna_cloud,
 }
 
 MountVerdict mount_verdict(const MountSide& s, const MountSideOptions& o) {
-  const auto outnumbers = [&](std::size_t more, std::size_t fewer) {
-    return more >= o.min_points && static_cast<double>(more) >= o.ratio * static_cast<double>(fewer);
+  const auto outnumbers = [&](std::size_t more, std::size_t fewer, std::size_t at_least) {
+    return more >= at_least && static_cast<double>(more) >= o.ratio * static_cast<double>(fewer);
   };
-  if (outnumbers(s.behind, s.before)) return MountVerdict::kAsRegistered;
-  if (outnumbers(s.before, s.behind)) return MountVerdict::kTurned;
+  if (outnumbers(s.behind, s.before, o.min_points)) return MountVerdict::kAsRegistered;
+  if (outnumbers(s.before, s.behind, o.min_points_to_turn)) return MountVerdict::kTurned;
   return MountVerdict::kUndecided;
 }
 
