@@ -10,10 +10,9 @@
 //
 // Verdict: at least `min_points` behind and `ratio` times as many as before: as registered; the
 // other way round, with at least `min_points_to_turn` before: turned (the front is the back).
-// Else undecided. On the acceptance sites
-// 701–712 the right poses had 3.6–∞ times more behind than before them (the fewest from the
-// ground, where the radome's points scatter in depth), the one wrong front/back (706-3) 9.5 times
-// more before.
+// Else undecided. On the acceptance sites 701–712 the right poses had 3.6–∞ times more behind
+// than before them (the fewest from the ground, where the radome's points scatter in depth), the
+// one wrong front/back (706-3) 9.5 times more before.
 #pragma once
 
 #include <cstddef>

@@ -247,8 +247,13 @@ void decide_front_by_mount(AntennaMeasurement& m, SilhouettePick& pick, const mo
     return boresight_downtilt(off_axis ? with_long_axis(R, axis_points) : R, up_board);
   };
   const double tilt = downtilt(*pick.best), tilt_turned = pick.turned ? downtilt(*pick.turned) : -tilt;
-  const FrontBack call =
-      decide_front_back(mount_verdict(side, options.mount), tilt, tilt_turned, deg2rad(options.max_uptilt_deg));
+  const MountVerdict mount = mount_verdict(side, options.mount);
+  const FrontBack call = decide_front_back(mount, tilt, tilt_turned, deg2rad(options.max_uptilt_deg));
+  const auto turn_round = [&] {
+    std::swap(*pick.best, *pick.turned);
+    pick.flipped_by_outline = false;
+    std::swap(side.before, side.behind);
+  };
   if (call.verdict == MountVerdict::kTurned && pick.turned) {
     m.warnings.push_back(
         call.by_downtilt
@@ -259,23 +264,17 @@ void decide_front_by_mount(AntennaMeasurement& m, SilhouettePick& pick, const mo
                           "registered and {} behind it, so the panel is turned round (its brackets and the mast are "
                           "behind it)",
                           side.before, side.behind));
-    std::swap(*pick.best, *pick.turned);
-    pick.flipped_by_outline = false;
-    std::swap(side.before, side.behind);
+    turn_round();
   }
   // In doubt the pose that tilts down is reported, the mount's the rival its σ covers.
   if (call.in_doubt && pick.turned) {
-    const bool mount_turns = mount_verdict(side, options.mount) == MountVerdict::kTurned;
+    const bool mount_turns = mount == MountVerdict::kTurned;
     m.warnings.push_back(fmt::format(
         "front and back are in doubt: the mount ({} points behind the panel, {} before it) puts the front where the "
         "panel tilts up by {:.1f}°, and mounts tilt panels down; the σ covers the panel turned round",
         mount_turns ? side.before : side.behind, mount_turns ? side.behind : side.before,
         -rad2deg(mount_turns ? tilt_turned : tilt)));
-    if (!mount_turns) {
-      std::swap(*pick.best, *pick.turned);
-      pick.flipped_by_outline = false;
-      std::swap(side.before, side.behind);
-    }
+    if (!mount_turns) turn_round();
     pick.rivals.push_back(pick.turned->T_board_antenna.linear());
   }
   m.mount_points = side;

@@ -62,6 +62,12 @@ EdgeMesh weld(const model::Mesh& mesh) {
 struct Pose {
   Mat3 R = Mat3::Identity();  // R_board_antenna
   Vec3 t = Vec3::Zero();      // p_board_antenna
+  Iso3 T() const {
+    Iso3 T_board_antenna = Iso3::Identity();
+    T_board_antenna.linear() = R;
+    T_board_antenna.translation() = t;
+    return T_board_antenna;
+  }
 };
 
 // One photo cropped around the antenna: gradient images of a Gaussian pyramid.
@@ -532,8 +538,7 @@ SilhouetteResult refine_by_silhouette(const model::Mesh& mesh_antenna, const Iso
   const Gathered g = gather_all(m, pose, prepared, intrinsics, 0, options.fine_search_px, options);
   Normal n = normal_equations(g, 1.0, options);
   const double prior_weight = n.inliers > 12 ? add_prior(n, pose.R, prior, options) : 0.0;
-  result.T_board_antenna.linear() = pose.R;
-  result.T_board_antenna.translation() = pose.t;
+  result.T_board_antenna = pose.T();
   result.views_used = g.views_with_samples;
   result.samples = n.inliers;
   result.inlier_fraction = g.candidates ? double(n.inliers) / double(g.candidates) : 0.0;
@@ -596,9 +601,7 @@ SilhouetteResult refine_by_silhouette(const model::Mesh& mesh_antenna, const Iso
   }
   if (rival && rival->score < best.score) {
     ok = false;
-    result.left_start = Iso3::Identity();
-    result.left_start->linear() = rival->pose.R;
-    result.left_start->translation() = rival->pose.t;
+    result.left_start = rival->pose.T();
     result.warnings.push_back(fmt::format(
         "silhouette: a pose turned {:.1f}° from the result fits the outline better (score {:.3f} vs {:.3f}) but lies "
         "more than {:.0f}° from the start: the start is probably wrong",
