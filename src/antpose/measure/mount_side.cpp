@@ -45,15 +45,10 @@ MountVerdict by_downtilt(double as_registered, double turned, double max_uptilt)
 }  // namespace
 
 FrontBack decide_front_back(MountVerdict mount, double downtilt_registered, double downtilt_turned, double max_uptilt) {
-  switch (mount) {
-    case MountVerdict::kAsRegistered:
-      if (downtilt_registered < -max_uptilt) return {MountVerdict::kUndecided, false, true};
-      return {mount, false, false};
-    case MountVerdict::kTurned:
-      if (downtilt_turned < -max_uptilt) return {MountVerdict::kUndecided, false, true};
-      return {mount, false, false};
-    case MountVerdict::kUndecided:
-      break;
+  if (mount != MountVerdict::kUndecided) {
+    const double chosen = mount == MountVerdict::kTurned ? downtilt_turned : downtilt_registered;
+    if (chosen < -max_uptilt) return {MountVerdict::kUndecided, false, true};  // the cues disagree
+    return {mount, false, false};
   }
   const auto verdict = by_downtilt(downtilt_registered, downtilt_turned, max_uptilt);
   return {verdict, verdict != MountVerdict::kUndecided, false};
