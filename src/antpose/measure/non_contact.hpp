@@ -125,6 +125,17 @@ struct NonContactOptions {
   /// Region points within this of the board's plane, inside that margin, are the board's.
   double board_thickness_m = 0.03;
   double points_axis_sigma_deg = 0.2;
+  /// Where the outline fits from no start, the search again with the long axis held to the
+  /// points' (non_contact.cpp), each descent monotone with this many step halvings
+  /// (SilhouetteOptions::max_step_halvings).
+  bool held_axis_search = true;
+  int held_axis_step_halvings = 3;
+  /// The points' axis of a narrow panel from the ground: 0.13–0.71° off on 8 development
+  /// antennas (RMS 0.47°), per axis.
+  double held_axis_sigma_deg = 0.35;
+  /// The yaw about a held axis is profiled (profile_yaw in non_contact.cpp) over ± this range in
+  /// these steps; yaws scoring within the margin of the minimum bound it.
+  double held_yaw_range_deg = 40, held_yaw_step_deg = 2, held_yaw_margin = 0.05;
   MountSideOptions mount;  // the mount's side decides front and back (mount_side.hpp)
   /// Where the mount's side cannot tell front from back, the downtilt's sign does: turning a
   /// panel round negates its downtilt, and mounts tilt panels down (tilt kits 0–15°), not up by

@@ -468,13 +468,30 @@ SilhouetteResult refine_by_silhouette(const model::Mesh& mesh_antenna, const Iso
     }
   });
 
+  const auto full_score = [&](const Pose& p) {
+    return score(gather_all(m, p, prepared, intrinsics, 0, options.fine_search_px, options), options);
+  };
+  // Stages (level, search in that level's px): the coarsest searches wide, every later one
+  // ±fine_search_px. A monotone descent also ends on a fine stage where the model is too narrow for
+  // a pyramid, on the edges the score and the covariance use (a narrow panel's own, not the
+  // mast's 20 px beyond it).
+  const bool monotone = options.max_step_halvings >= 0;
+  std::vector<std::pair<int, double>> stages;
+  for (int level = top; level >= 0; --level)
+    stages.emplace_back(level, level == top ? std::max(options.fine_search_px, options.search_range_px / std::ldexp(1.0, level))
+                                            : options.fine_search_px);
+  if (monotone && stages.back().second > options.fine_search_px) stages.emplace_back(0, options.fine_search_px);
+
   const auto descend = [&](Pose p) {
     Descent d;
     d.pose = p;
-    for (int level = top; level >= 0; --level) {
+    for (const auto& [level, search] : stages) {
       const double scale = std::ldexp(1.0, level);
-      const double search =
-          level == top ? std::max(options.fine_search_px, options.search_range_px / scale) : options.fine_search_px;
+      // Monotone at full resolution: Gauss–Newton re-associates the edges at every step, and
+      // nearer a strong clutter edge than the panel's own it walks off the outline while each
+      // step looks good to its own linearisation; the score (which ranks the starts) does not.
+      const bool checked = monotone && level == 0;
+      double current = checked ? full_score(d.pose) : 0.0;
       d.converged = false;
       Vec6 previous_step = Vec6::Zero();
       for (int it = 0; it < options.max_iterations_per_level; ++it) {
@@ -498,6 +515,20 @@ SilhouetteResult refine_by_silhouette(const model::Mesh& mesh_antenna, const Iso
         // and half of it lands between the two poses.
         const bool swinging = motion < options.swing_motion_px && delta->dot(n.H * previous_step) < 0.0;
         if (swinging) *delta /= 2;
+        if (checked) {
+          bool taken = false;
+          for (int halving = 0; halving <= options.max_step_halvings && !taken; ++halving) {
+            const double trial = full_score(Pose{exp_so3(delta->head<3>()) * d.pose.R, d.pose.t + delta->tail<3>()});
+            if (trial <= current)
+              taken = true, current = trial;
+            else
+              *delta /= 2;
+          }
+          if (!taken) {  // no step along Gauss–Newton's direction lowers the score: arrived
+            d.converged = true;
+            break;
+          }
+        }
         d.pose.R = exp_so3(delta->head<3>()) * d.pose.R;
         d.pose.t += delta->tail<3>();
         previous_step = *delta;
@@ -507,7 +538,7 @@ SilhouetteResult refine_by_silhouette(const model::Mesh& mesh_antenna, const Iso
         }
       }
     }
-    d.score = score(gather_all(m, d.pose, prepared, intrinsics, 0, options.fine_search_px, options), options);
+    d.score = full_score(d.pose);
     return d;
   };
 

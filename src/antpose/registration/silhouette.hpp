@@ -73,6 +73,10 @@ struct SilhouetteOptions {
   double min_coarse_width_px = 16;    // the coarsest level keeps the model's projection this wide
   int max_iterations_per_level = 12;  // Gauss–Newton steps per level and descent; done below 0.01 px
   double swing_motion_px = 0.05;      // or below this when a step reverses the last (see the .cpp)
+  // ≥ 0: a monotone descent at full resolution: a step that raises the score is halved up to this
+  // many times, and the descent has arrived when none lowers it; where the model is too narrow
+  // for a pyramid, a ±fine_search_px stage follows the wide one. −1: steps are not checked.
+  int max_step_halvings = -1;
   // A step turning further is shortened to this (a trust region; see the file comment).
   double max_step_rotation_rad = deg2rad(5.0);
   double tukey_c = 4.685;             // × robust σ (MAD), σ ≥ 0.5 px of the level
