@@ -412,7 +412,7 @@ void register_model(AntennaMeasurement& m, const model::AntennaModel& model, con
   // The outline decides the yaw where the points cannot (docs/non-contact.md).
   std::optional<Mat3> cov_silhouette;
   if (options.silhouette) {
-    auto pick = silhouette_search(model, T_antenna_board.inverse(), scene, options);
+      auto pick = silhouette_search(model, T_antenna_board.inverse(), scene, options);
     // A narrow panel seen from below can trade yaw for tilt in its outline, and the mast's edges
     // beside it lure the descents away: where no start converged, the search is repeated with the
     // long axis held to the points'.
@@ -435,7 +435,11 @@ void register_model(AntennaMeasurement& m, const model::AntennaModel& model, con
           "panel's yaw: is the whole antenna inside the photos, free of other panels in front of it, and is the "
           "model this antenna's? (closest start: {})",
           pick.tried, fmt::join(pick.closest_failure, "; ")));
-    const Vec3 axis_points = points_long_axis(cloud, model_prepared, pick.best->T_board_antenna.inverse(), options);
+    // With the axis held, the points' axis is the held one: ICP from the outline's pose may find
+    // another (below).
+    const Vec3 axis_points = held_axis ? *held_axis
+                                       : points_long_axis(cloud, model_prepared, pick.best->T_board_antenna.inverse(),
+                                                          options);
     decide_front_by_mount(m, pick, model, model_prepared, axis_points, gopts.fine.max_correspondence_distance_m,
                           scene.up_board, options);
     T_antenna_board = pick.best->T_board_antenna.inverse();
@@ -445,9 +449,20 @@ void register_model(AntennaMeasurement& m, const model::AntennaModel& model, con
       const auto profile = profile_yaw(model, pick.best->T_board_antenna, scene, options);
       T_antenna_board = profile.T_board_antenna.inverse();
       const Mat3& R = profile.T_board_antenna.linear();
+      // The points' ICP from the result's pose may settle on another axis (clutter in the region
+      // pulls it differently from another start: 1604-2, 3.5° off where the held one was 0.6°):
+      // the held axis stays, and its σ covers both, as in hold_axis_to_points.
+      const Vec3 axis_again = points_long_axis(cloud, model_prepared, T_antenna_board, options);
+      const double disagreement = std::asin(std::min(1.0, axis_again.cross(R.col(2)).norm()));
       const double sa = deg2rad(options.held_axis_sigma_deg);
       const double sy = (profile.high_rad - profile.low_rad) / 2 / std::sqrt(3.0);
-      *cov_silhouette += across_long_axis(R, sa * sa) + sy * sy * R.col(2) * R.col(2).transpose();
+      *cov_silhouette += across_long_axis(R, sa * sa + std::pow(disagreement / 2, 2)) +
+                         sy * sy * R.col(2) * R.col(2).transpose();
+      if (rad2deg(disagreement) > options.axis_gate_deg)
+        m.warnings.push_back(fmt::format(
+            "the points' long axis depends on where their registration starts: {:.1f}° apart from the outline's "
+            "pose and from the points' own; the downtilt and roll σ cover both",
+            rad2deg(disagreement)));
       m.warnings.push_back(fmt::format(
           "the outline fitted from no start with its long axis free; it did with the points' axis held, so the "
           "downtilt and roll are the points' and the outline fixes the yaw about their axis, within {}{:+.0f}° to "
@@ -463,8 +478,9 @@ void register_model(AntennaMeasurement& m, const model::AntennaModel& model, con
       m.warnings.push_back(
           "the outline turned the points' front/back decision (the brackets' outline fits "
           "clearly better the other way round)");
-    if (const auto held = hold_axis_to_points(m, T_antenna_board, *cov_silhouette, model, axis_points, scene, options))
-      cov_silhouette = held;
+    if (!held_axis)
+      if (const auto held = hold_axis_to_points(m, T_antenna_board, *cov_silhouette, model, axis_points, scene, options))
+        cov_silhouette = held;
   }
   m.R_board_antenna = T_antenna_board.rotation().transpose();
   m.p_board_antenna = T_antenna_board.inverse().translation();
