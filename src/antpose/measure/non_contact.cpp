@@ -139,6 +139,8 @@ registration::SilhouetteResult refine_holding_axis(const model::AntennaModel& mo
                                                    const Vec3& axis_board, const Scene& scene,
                                                    registration::SilhouetteOptions options, int step_halvings) {
   options.max_step_halvings = step_halvings;
+  // Monotone steps are short where the score is flat: more of them, none of which can raise it.
+  options.max_iterations_per_level *= 2;
   const double held = deg2rad(0.01);
   const Mat3 R = with_long_axis(start.linear(), axis_board);
   const registration::RotationPrior prior{R, across_long_axis(R, 1 / (held * held))};
