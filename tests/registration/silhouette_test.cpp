@@ -86,7 +86,7 @@ SyntheticScene make_scene(const SceneSpec& spec = {}) {
   sim::MeshObject pole;
   pole.name = "pole";
   pole.mesh = sim::cylinder_mesh(Vec3(mast.x(), mast.y(), 0), Vec3(mast.x(), mast.y(), spec.antenna_height_m + 1.4),
-                                  spec.mast_radius_m, 24);
+                                 spec.mast_radius_m, 24);
   pole.albedo = 0.45;
   scene.meshes.push_back(pole);
   for (double dz : {-0.33, 0.33}) {  // clamp arms from the brackets to the pole: edges not in the model
@@ -114,8 +114,8 @@ SyntheticScene make_scene(const SceneSpec& spec = {}) {
   for (double d : spec.view_offsets_deg) {
     const double a = view_az + deg2rad(d);
     sim::CameraPose pose;
-    pose.p_world_camera = p_world_antenna + spec.distance_m * Vec3(std::sin(a), std::cos(a), 0) -
-                          Vec3(0, 0, spec.below_m);
+    pose.p_world_camera =
+        p_world_antenna + spec.distance_m * Vec3(std::sin(a), std::cos(a), 0) - Vec3(0, 0, spec.below_m);
     Vec3 z = (p_world_antenna - pose.p_world_camera).normalized();
     if (spec.look_away) z = (Vec3(-z.x(), -z.y(), 0.2)).normalized();  // turned away from the mast
     const Vec3 x = z.cross(Vec3::UnitZ()).normalized(), y = z.cross(x);
@@ -343,8 +343,8 @@ TEST(Silhouette, ANarrowPanelInFrontOfAWideMastIsNotAConfidentWrongAnswer) {
     const Iso3 start = perturbed(s.T_board_antenna, yaw, 1.0, Vec3(0.02, -0.02, 0.02));
     const auto r = refine_by_silhouette(s.mesh_antenna, start, s.views, s.intrinsics, {});
     const Vec3 after = axis_errors_deg(r.T_board_antenna.linear(), s.T_board_antenna.linear());
-    std::printf("start yaw %+.0f°: after %.2f %.2f %.2f°, converged %d, score %.3f, inliers %.0f %%, rms %.2f px\n", yaw,
-                after.x(), after.y(), after.z(), r.converged, r.score, 100 * r.inlier_fraction, r.rms_px);
+    std::printf("start yaw %+.0f°: after %.2f %.2f %.2f°, converged %d, score %.3f, inliers %.0f %%, rms %.2f px\n",
+                yaw, after.x(), after.y(), after.z(), r.converged, r.score, 100 * r.inlier_fraction, r.rms_px);
     for (const auto& w : r.warnings) std::printf("warning: %s\n", w.c_str());
     if (r.converged) {
       EXPECT_LT(std::abs(after.z()), 3.0);

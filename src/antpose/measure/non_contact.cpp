@@ -133,14 +133,21 @@ Mat3 with_long_axis(const Mat3& R_board_antenna, const Vec3& axis_board) {
   return Eigen::Quaterniond::FromTwoVectors(R_board_antenna.col(2), axis_board).toRotationMatrix() * R_board_antenna;
 }
 
-// The outline's refinement with the long axis held to `axis_board` (a prior far tighter than
-// either measurement on the two rotations that move it) and monotone steps; `options` otherwise.
+// The outline's options for the descents with the long axis held: monotone steps
+// (SilhouetteOptions::max_step_halvings), and twice as many of them, since monotone steps are
+// short where the score is flat and none of them can raise it.
+registration::SilhouetteOptions held_axis_descent(const NonContactOptions& options) {
+  auto o = options.silhouette_options;
+  o.max_step_halvings = options.held_axis_step_halvings;
+  o.max_iterations_per_level *= 2;
+  return o;
+}
+
+// The outline's refinement with the long axis held to `axis_board`: a prior far tighter than
+// either measurement on the two rotations that move it.
 registration::SilhouetteResult refine_holding_axis(const model::AntennaModel& model, const Iso3& start,
                                                    const Vec3& axis_board, const Scene& scene,
-                                                   registration::SilhouetteOptions options, int step_halvings) {
-  options.max_step_halvings = step_halvings;
-  // Monotone steps are short where the score is flat: more of them, none of which can raise it.
-  options.max_iterations_per_level *= 2;
+                                                   const registration::SilhouetteOptions& options) {
   const double held = deg2rad(0.01);
   const Mat3 R = with_long_axis(start.linear(), axis_board);
   const registration::RotationPrior prior{R, across_long_axis(R, 1 / (held * held))};
@@ -165,7 +172,8 @@ struct SilhouettePick {
 };
 
 SilhouettePick silhouette_search(const model::AntennaModel& model, const Iso3& T_board_antenna, const Scene& scene,
-                                 const NonContactOptions& options, const std::optional<Vec3>& held_axis = std::nullopt) {
+                                 const NonContactOptions& options,
+                                 const std::optional<Vec3>& held_axis = std::nullopt) {
   const auto& views = scene.outline_views;
   SilhouettePick pick;
   std::vector<registration::SilhouetteResult> done;
@@ -176,8 +184,7 @@ SilhouettePick silhouette_search(const model::AntennaModel& model, const Iso3& T
   // axis the starts lie on it and every descent keeps it (refine_holding_axis).
   const Vec3 up = held_axis ? held_axis->normalized() : Vec3(scene.up_board.normalized());
   const auto refine = [&](const Iso3& start) {
-    return held_axis ? refine_holding_axis(model, start, *held_axis, scene, options.silhouette_options,
-                                           options.held_axis_step_halvings)
+    return held_axis ? refine_holding_axis(model, start, *held_axis, scene, held_axis_descent(options))
                      : registration::refine_by_silhouette(model.mesh_antenna, start, views, scene.intrinsics,
                                                           options.silhouette_options);
   };
@@ -363,17 +370,18 @@ std::optional<Mat3> hold_axis_to_points(AntennaMeasurement& m, Iso3& T_antenna_b
 // truth scored up to 0.042 above it (1102-1, 1402-1). So the minimum is taken, and the yaws
 // scoring within options.held_yaw_margin of it bound the yaw.
 struct YawProfile {
-  Iso3 T_board_antenna;  // at the profile's minimum
+  Iso3 T_board_antenna;              // at the profile's minimum
   double low_rad = 0, high_rad = 0;  // the bounded range, from the minimum
-  bool open = false;  // the range reaches the profile's end: the yaw is not bounded
+  bool open = false;                 // the range reaches the profile's end: the yaw is not bounded
 };
 
 YawProfile profile_yaw(const model::AntennaModel& model, const Iso3& T_board_antenna, const Scene& scene,
                        const NonContactOptions& options) {
-  auto o = options.silhouette_options;
+  // At each yaw only the position is refit, with the normal number of steps.
+  auto o = held_axis_descent(options);
+  o.max_iterations_per_level = options.silhouette_options.max_iterations_per_level;
   o.rival_yaw_offsets_rad.clear();
   o.free = {false, false, false, true, true, true};
-  o.max_step_halvings = options.held_axis_step_halvings;  // as refine_holding_axis
   const Vec3 axis = T_board_antenna.linear().col(2);
   const int n = static_cast<int>(std::round(options.held_yaw_range_deg / options.held_yaw_step_deg));
   std::vector<double> yaws, scores;
@@ -393,8 +401,9 @@ YawProfile profile_yaw(const model::AntennaModel& model, const Iso3& T_board_ant
   while (hi + 1 < scores.size() && scores[hi + 1] <= limit) ++hi;
   YawProfile profile{poses[best], yaws[lo] - yaws[best], yaws[hi] - yaws[best], lo == 0 || hi + 1 == scores.size()};
   // Between the steps: the yaw freed again from the best of them.
-  o.free = options.silhouette_options.free;
-  const auto r = refine_holding_axis(model, poses[best], axis, scene, o, options.held_axis_step_halvings);
+  o = held_axis_descent(options);
+  o.rival_yaw_offsets_rad.clear();
+  const auto r = refine_holding_axis(model, poses[best], axis, scene, o);
   if (r.score <= scores[best]) profile.T_board_antenna = r.T_board_antenna;
   return profile;
 }
@@ -414,7 +423,7 @@ void register_model(AntennaMeasurement& m, const model::AntennaModel& model, con
   // The outline decides the yaw where the points cannot (docs/non-contact.md).
   std::optional<Mat3> cov_silhouette;
   if (options.silhouette) {
-      auto pick = silhouette_search(model, T_antenna_board.inverse(), scene, options);
+    auto pick = silhouette_search(model, T_antenna_board.inverse(), scene, options);
     // A narrow panel seen from below can trade yaw for tilt in its outline, and the mast's edges
     // beside it lure the descents away: where no start converged, the search is repeated with the
     // long axis held to the points'.
@@ -439,9 +448,8 @@ void register_model(AntennaMeasurement& m, const model::AntennaModel& model, con
           pick.tried, fmt::join(pick.closest_failure, "; ")));
     // With the axis held, the points' axis is the held one: ICP from the outline's pose may find
     // another (below).
-    const Vec3 axis_points = held_axis ? *held_axis
-                                       : points_long_axis(cloud, model_prepared, pick.best->T_board_antenna.inverse(),
-                                                          options);
+    const Vec3 axis_points =
+        held_axis ? *held_axis : points_long_axis(cloud, model_prepared, pick.best->T_board_antenna.inverse(), options);
     decide_front_by_mount(m, pick, model, model_prepared, axis_points, gopts.fine.max_correspondence_distance_m,
                           scene.up_board, options);
     T_antenna_board = pick.best->T_board_antenna.inverse();
@@ -455,11 +463,11 @@ void register_model(AntennaMeasurement& m, const model::AntennaModel& model, con
       // pulls it differently from another start: 1604-2, 3.5° off where the held one was 0.6°):
       // the held axis stays, and its σ covers both, as in hold_axis_to_points.
       const Vec3 axis_again = points_long_axis(cloud, model_prepared, T_antenna_board, options);
-      const double disagreement = std::asin(std::min(1.0, axis_again.cross(R.col(2)).norm()));
+      const double disagreement = angle_between(axis_again, R.col(2));
       const double sa = deg2rad(options.held_axis_sigma_deg);
       const double sy = (profile.high_rad - profile.low_rad) / 2 / std::sqrt(3.0);
-      *cov_silhouette += across_long_axis(R, sa * sa + std::pow(disagreement / 2, 2)) +
-                         sy * sy * R.col(2) * R.col(2).transpose();
+      *cov_silhouette +=
+          across_long_axis(R, sa * sa + std::pow(disagreement / 2, 2)) + sy * sy * R.col(2) * R.col(2).transpose();
       if (rad2deg(disagreement) > options.axis_gate_deg)
         m.warnings.push_back(fmt::format(
             "the points' long axis depends on where their registration starts: {:.1f}° apart from the outline's "
@@ -481,7 +489,8 @@ void register_model(AntennaMeasurement& m, const model::AntennaModel& model, con
           "the outline turned the points' front/back decision (the brackets' outline fits "
           "clearly better the other way round)");
     if (!held_axis)
-      if (const auto held = hold_axis_to_points(m, T_antenna_board, *cov_silhouette, model, axis_points, scene, options))
+      if (const auto held =
+              hold_axis_to_points(m, T_antenna_board, *cov_silhouette, model, axis_points, scene, options))
         cov_silhouette = held;
   }
   m.R_board_antenna = T_antenna_board.rotation().transpose();

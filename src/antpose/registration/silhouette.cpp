@@ -478,8 +478,9 @@ SilhouetteResult refine_by_silhouette(const model::Mesh& mesh_antenna, const Iso
   const bool monotone = options.max_step_halvings >= 0;
   std::vector<std::pair<int, double>> stages;
   for (int level = top; level >= 0; --level)
-    stages.emplace_back(level, level == top ? std::max(options.fine_search_px, options.search_range_px / std::ldexp(1.0, level))
-                                            : options.fine_search_px);
+    stages.emplace_back(level, level == top
+                                   ? std::max(options.fine_search_px, options.search_range_px / std::ldexp(1.0, level))
+                                   : options.fine_search_px);
   if (monotone && stages.back().second > options.fine_search_px) stages.emplace_back(0, options.fine_search_px);
 
   const auto descend = [&](Pose p) {
