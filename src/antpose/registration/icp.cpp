@@ -7,7 +7,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <tbb/blocked_range.h>
-#include <tbb/parallel_reduce.h>
+#include <tbb/parallel_reduce.h>  // parallel_deterministic_reduce
 
 #include "antpose/registration/local_geometry.hpp"
 
@@ -67,8 +67,11 @@ Sums accumulate(const PreparedCloud& source, const PreparedCloud& target, const 
   const double max_d2 = o.max_correspondence_distance_m * o.max_correspondence_distance_m;
   const auto& src = source.cloud.points;
   const auto& dst = target.cloud.points;
-  return tbb::parallel_reduce(
-      tbb::blocked_range<std::size_t>(0, src.size(), 128), Sums{},
+  // Deterministic: the same split into ranges and the same order of additions on every run and
+  // thread count. A floating-point sum in a scheduling-dependent order differs in the last bits,
+  // and the measurement's held-axis search, on a flat outline score, turned that into a degree.
+  return tbb::parallel_deterministic_reduce(
+      tbb::blocked_range<std::size_t>(0, src.size(), 512), Sums{},
       [&](const tbb::blocked_range<std::size_t>& range, Sums s) {
         for (std::size_t i = range.begin(); i < range.end(); ++i) {
           const Vec3 p = T * src[i];
