@@ -1,6 +1,7 @@
 #include "antpose/measure/field_check.hpp"
 
 #include <cmath>
+#include <numbers>
 #include <random>
 
 #include <gmock/gmock.h>
@@ -100,6 +101,104 @@ TEST(FieldCheck, AUniformTurnOfTheHorizontalFieldIsInvisible) {
   const Vec3 turned = Eigen::AngleAxisd(deg2rad(5.0), Vec3::UnitZ()) * earth(site);
   const auto c = check_field(with_noise(std::vector<Vec3>(12, turned), 0.1, 3), site, {});
   EXPECT_FALSE(c.disturbed);
+}
+
+// Each photo's field seen through a track whose tilt is off by up to `tilt_deg` (walking): turned
+// about a random horizontal axis.
+std::vector<Vec3> with_tilt_errors(std::vector<Vec3> b, double tilt_deg, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> angle(-deg2rad(tilt_deg), deg2rad(tilt_deg)), axis(0.0, 2 * std::numbers::pi);
+  for (auto& v : b) {
+    const double a = axis(rng);
+    v = Eigen::AngleAxisd(angle(rng), Vec3(std::cos(a), std::sin(a), 0.0)) * v;
+  }
+  return b;
+}
+
+// Site 1612: from 20 m the mast's field is the same at every photo. It turns the compass by 3°
+// and steepens the dip by 1.6°; with the walk's tilt errors every photo stays within 2° of WMM's
+// dip and the photos agree, but their median dip does not agree with WMM's.
+TEST(FieldCheck, AFieldTurnedAlikeAtEveryPhotoIsSeenInTheMedianDip) {
+  const auto site = hangzhou();
+  const Vec3 b0 = earth(site);
+  const Vec3 east = Vec3::UnitX(), dip_direction = Vec3(0.0, std::sin(site.inclination), std::cos(site.inclination));
+  const double h = b0.head<2>().norm(), f = b0.norm();
+  const Vec3 b = b0 + h * std::tan(deg2rad(3.0)) * east - f * deg2rad(1.6) * dip_direction;
+  const auto photos = with_noise(with_tilt_errors(std::vector<Vec3>(12, b), 0.35, 4), 0.1, 5);
+  const auto c = check_field(photos, site, {});
+  EXPECT_LT(rad2deg(c.worst_dip_rad), 2.0);
+  EXPECT_LT(c.strength_spread_fraction, 0.015);
+  EXPECT_LT(rad2deg(c.dip_spread_rad), 2.5);
+  EXPECT_NEAR(rad2deg(c.median_dip_offset_rad), 1.6, 0.3);
+  EXPECT_TRUE(c.disturbed);
+  ASSERT_EQ(c.warnings.size(), 1u);
+  EXPECT_THAT(c.warnings[0], HasSubstr("(median dip +1."));
+  // Only the dip's part is seen: σ ≈ F · 1.6° / H, about half the turn's size again.
+  EXPECT_GT(rad2deg(c.heading_sigma_rad), 2.0);
+
+  // The same walk's tilt errors on the Earth's field alone raise no warning.
+  const auto clean = check_field(with_noise(with_tilt_errors(std::vector<Vec3>(12, b0), 0.35, 4), 0.1, 5), site, {});
+  EXPECT_FALSE(clean.disturbed);
+  EXPECT_LT(std::abs(rad2deg(clean.median_dip_offset_rad)), 0.3);
+}
+
+// Site 1306: an 18 m mast magnetised as the simulator makes it (12 dipoles up its axis, induced
+// along the Earth's field plus a horizontal remanent part), scaled to turn the compass by 4.5° at
+// a walk on an arc 3 m round a board 14 m away. The turn is nearly the same at every photo,
+// strength and dip stay near WMM's and spread little; only the strength's fall-off towards the
+// mast is seen, as a trend over where the photos were taken.
+TEST(FieldCheck, AStrengthChangingWithThePhonesPositionIsADisturbance) {
+  const auto site = hangzhou();
+  const Vec3 b0 = earth(site);
+  auto tall_mast = [](const Vec3& p, const Vec3& moment_Am2) {
+    Vec3 b = Vec3::Zero();
+    for (int k = 0; k < 12; ++k) {
+      const Vec3 r = p - Vec3(0.0, 0.0, 18.0 * (k + 0.5) / 12.0);
+      const Vec3 u = r.normalized();
+      b += 1e-7 * (3.0 * u * u.dot(moment_Am2) - moment_Am2) / std::pow(r.norm(), 3) * 1e6;
+    }
+    return b;
+  };
+  const double bearing = deg2rad(120.0);
+  const Vec3 board(14.0 * std::sin(bearing), 14.0 * std::cos(bearing), 1.2);
+  std::vector<Vec3> where;
+  for (int i = 0; i < 12; ++i) {
+    const double phi = bearing + deg2rad(-35.0 + 70.0 * i / 11.0);
+    where.push_back(board - 3.0 * Vec3(std::sin(phi), std::cos(phi), -0.02 * (i % 3)));
+  }
+  const Vec3 direction = (b0.normalized() - Vec3::UnitY()).normalized();
+  const Vec3 unit = tall_mast(where[6], direction);
+  const double h = b0.head<2>().norm(), t = std::tan(deg2rad(4.5));
+  const Vec3 moment = direction * (t * h / (unit.x() - t * unit.y()));  // (h ŷ + s unit) turned by 4.5°
+  std::vector<Vec3> b;
+  double least_turn = 90.0;
+  for (const Vec3& p : where) {
+    b.push_back(b0 + tall_mast(p, moment));
+    least_turn = std::min(least_turn, std::abs(rad2deg(std::atan2(b.back().x(), b.back().y()))));
+  }
+  ASSERT_GT(least_turn, 3.5);
+  const auto photos = with_noise(with_tilt_errors(b, 0.35, 6), 0.08, 7);  // 25 samples of 0.4 µT noise
+  const auto blind = check_field(photos, site, {});                       // tests 1–3 only
+  EXPECT_FALSE(blind.disturbed) << blind.worst_strength_fraction << " " << rad2deg(blind.worst_dip_rad) << " "
+                                << blind.strength_spread_fraction << " " << rad2deg(blind.median_dip_offset_rad);
+  const auto c = check_field(photos, site, {}, where);
+  EXPECT_GT(c.strength_trend_fraction, 0.005);
+  EXPECT_GT(c.trend_f_statistic, 10.0);
+  EXPECT_TRUE(c.disturbed);
+  ASSERT_EQ(c.warnings.size(), 1u);
+  EXPECT_THAT(c.warnings[0], HasSubstr("% along the walk"));
+
+  // Without the mast the same walk shows no trend.
+  const auto clean =
+      check_field(with_noise(with_tilt_errors(std::vector<Vec3>(12, b0), 0.35, 6), 0.08, 7), site, {}, where);
+  EXPECT_FALSE(clean.disturbed);
+  EXPECT_LT(clean.strength_trend_fraction, 0.005);
+
+  // A walk along a line fits one slope; the positions' count must match the fields'.
+  std::vector<Vec3> line;
+  for (int i = 0; i < 12; ++i) line.emplace_back(0.0, 12.0 + 0.4 * i, 1.2);
+  EXPECT_GT(check_field(photos, site, {}, line).trend_f_statistic, 0.0);
+  EXPECT_THROW(check_field(photos, site, {}, std::vector<Vec3>(3, Vec3::Zero())), std::invalid_argument);
 }
 
 TEST(FieldCheck, AFieldStrongerThanTheEarthsIsADisturbance) {

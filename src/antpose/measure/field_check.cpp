@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
+
+#include <Eigen/SVD>
 
 #include <fmt/format.h>
 
@@ -15,11 +18,39 @@ double spread(const std::vector<double>& v) {
   return *hi - *lo;
 }
 
+// Test 4: least squares F_i = a + gᵀ(h_i − h̄) over the horizontal positions h. A walk along a line
+// leaves one slope; the SVD's rank says how many the positions fix.
+void fit_strength_gradient(const std::vector<double>& strength_uT, const std::vector<Vec3>& p_world_m, FieldCheck& c) {
+  const auto n = static_cast<Eigen::Index>(strength_uT.size());
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  for (const Vec3& p : p_world_m) mean += p.head<2>() / static_cast<double>(n);
+  Eigen::MatrixXd A(n, 2);
+  Eigen::VectorXd y(n);
+  const double f_mean = Eigen::Map<const Eigen::VectorXd>(strength_uT.data(), n).mean();
+  for (Eigen::Index i = 0; i < n; ++i) {
+    A.row(i) = (p_world_m[static_cast<std::size_t>(i)].head<2>() - mean).transpose();
+    y(i) = strength_uT[static_cast<std::size_t>(i)] - f_mean;
+  }
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(A, Eigen::ComputeThinU | Eigen::ComputeThinV);
+  svd.setThreshold(1e-3);  // slopes along less than ~0.1 % of the walk's extent are not fitted
+  const auto slopes = svd.rank();
+  const auto dof = n - 1 - slopes;
+  if (slopes == 0 || dof < 3) return;
+  const Eigen::Vector2d g = svd.solve(y);
+  const Eigen::VectorXd fitted = A * g;
+  const double rss0 = y.squaredNorm(), rss1 = (y - fitted).squaredNorm();
+  c.strength_gradient_uT_per_m = g.norm();
+  c.strength_trend_fraction = (fitted.maxCoeff() - fitted.minCoeff()) / median(strength_uT);
+  c.trend_f_statistic =
+      (rss0 - rss1) / static_cast<double>(slopes) / std::max(rss1 / static_cast<double>(dof), 1e-12 * rss0 + 1e-300);
+}
+
 }  // namespace
 
-std::vector<Vec3> field_at_photos(const orientation::ImuData& data, const orientation::OrientationTrack& track,
-                                  const std::vector<double>& t_photos, double half_window_s) {
-  std::vector<Vec3> out;
+std::vector<std::optional<Vec3>> field_at_photos(const orientation::ImuData& data,
+                                                 const orientation::OrientationTrack& track,
+                                                 const std::vector<double>& t_photos, double half_window_s) {
+  std::vector<std::optional<Vec3>> out;
   const auto& m = data.magnetometer;
   for (const double t : t_photos) {
     Vec3 sum = Vec3::Zero();
@@ -27,18 +58,24 @@ std::vector<Vec3> field_at_photos(const orientation::ImuData& data, const orient
     for (std::size_t i = 0; i < m.size(); ++i)
       if (std::abs(m.t[i] - t) <= half_window_s && track.contains(m.t[i]))
         sum += track.at(m.t[i]).q_world_device * m.v[i], ++n;
-    if (n > 0) out.push_back(sum / n);
+    out.push_back(n > 0 ? std::optional<Vec3>(sum / n) : std::nullopt);
   }
   return out;
 }
 
 FieldCheck check_field(const std::vector<Vec3>& field_world_uT, const std::optional<geomag::SiteField>& site,
-                       const FieldCheckOptions& o) {
+                       const FieldCheckOptions& o, const std::vector<Vec3>& p_world_m) {
+  if (!p_world_m.empty() && p_world_m.size() != field_world_uT.size())
+    throw std::invalid_argument(
+        fmt::format("check_field: {} positions for {} fields", p_world_m.size(), field_world_uT.size()));
   FieldCheck c;
-  for (const Vec3& b : field_world_uT) {
+  std::vector<Vec3> positions;
+  for (std::size_t i = 0; i < field_world_uT.size(); ++i) {
+    const Vec3& b = field_world_uT[i];
     if (!(b.norm() > 0.0)) continue;
     c.strength_uT.push_back(b.norm());
     c.dip_rad.push_back(std::asin(std::clamp(-b.z() / b.norm(), -1.0, 1.0)));
+    if (!p_world_m.empty()) positions.push_back(p_world_m[i]);
   }
   if (c.strength_uT.empty()) return c;
   const double f_median = median(c.strength_uT), dip_median = median(c.dip_rad);
@@ -58,25 +95,37 @@ FieldCheck check_field(const std::vector<Vec3>& field_world_uT, const std::optio
   }
   c.strength_spread_fraction = spread(c.strength_uT) / f_median;
   c.dip_spread_rad = spread(c.dip_rad);
+  if (site) c.median_dip_offset_rad = dip_median - site->inclination;
+  if (!positions.empty()) fit_strength_gradient(c.strength_uT, positions, c);
 
-  const bool off_earth = c.worst_strength_fraction > o.strength_tolerance || c.worst_dip_rad > o.dip_tolerance;
-  const bool uneven = c.strength_spread_fraction > o.strength_spread || c.dip_spread_rad > o.dip_spread;
+  const bool off_earth = c.worst_strength_fraction > o.strength_tolerance || c.worst_dip_rad > o.dip_tolerance ||
+                         std::abs(c.median_dip_offset_rad) > o.median_dip_tolerance;
+  const bool trend = c.strength_trend_fraction > o.strength_trend && c.trend_f_statistic > o.trend_significance;
+  const bool uneven = c.strength_spread_fraction > o.strength_spread || c.dip_spread_rad > o.dip_spread || trend;
   c.disturbed = off_earth || uneven;
   if (!c.disturbed) return c;
   const double horizontal = f_ref * std::cos(dip_ref);
   c.heading_sigma_rad = seen / std::max(horizontal, 1e-3 * f_ref);
-  const std::string limits =
-      fmt::format("limits {:.0f} % and {:.1f}° against WMM, {:.1f} % and {:.1f}° over the photos",
-                  100 * o.strength_tolerance, rad2deg(o.dip_tolerance), 100 * o.strength_spread, rad2deg(o.dip_spread));
+  const std::string limits = fmt::format(
+      "limits {:.0f} % and {:.1f}° against WMM ({:.1f}° for the median dip), {:.1f} % and {:.1f}° over the photos",
+      100 * o.strength_tolerance, rad2deg(o.dip_tolerance), rad2deg(o.median_dip_tolerance), 100 * o.strength_spread,
+      rad2deg(o.dip_spread));
   const std::string against =
-      site ? fmt::format("differs from the WMM's at the site by up to {:.1f} % in strength and {:.1f}° in dip, and ",
-                         100 * c.worst_strength_fraction, rad2deg(c.worst_dip_rad))
+      site ? fmt::format(
+                 "differs from the WMM's at the site by up to {:.1f} % in strength and {:.1f}° in dip (median dip "
+                 "{:+.1f}°), and ",
+                 100 * c.worst_strength_fraction, rad2deg(c.worst_dip_rad), rad2deg(c.median_dip_offset_rad))
            : std::string();
+  const std::string along =
+      trend ? fmt::format(", its strength changing by {:.1f} % along the walk ({:.2f} µT/m, limit {:.1f} %)",
+                          100 * c.strength_trend_fraction, c.strength_gradient_uT_per_m, 100 * o.strength_trend)
+            : std::string();
   c.warnings.push_back(fmt::format(
       "magnetic disturbance: at the photos the field {}varies between them by {:.1f} % in strength and {:.1f}° in dip "
-      "({}): steel nearby turns the compass; the azimuth's σ includes an estimated {:.1f}°, but the error may be "
+      "({}){}: steel nearby turns the compass; the azimuth's σ includes an estimated {:.1f}°, but the error may be "
       "larger",
-      against, 100 * c.strength_spread_fraction, rad2deg(c.dip_spread_rad), limits, rad2deg(c.heading_sigma_rad)));
+      against, 100 * c.strength_spread_fraction, rad2deg(c.dip_spread_rad), limits, along,
+      rad2deg(c.heading_sigma_rad)));
   return c;
 }
 

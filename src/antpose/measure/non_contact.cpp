@@ -673,8 +673,16 @@ NonContactResult measure_non_contact(const Capture& capture, const NonContactSet
   if (data.has_magnetometer()) {
     std::vector<double> shot_t;
     for (const auto i : result.posed) shot_t.push_back(capture.shots[i].t + setup.camera_imu.time_offset_s);
-    result.field =
-        check_field(field_at_photos(data, track, shot_t, options.field.half_window_s), result.site, options.field);
+    const auto fields = field_at_photos(data, track, shot_t, options.field.half_window_s);
+    // Where each photo was taken: the camera centre in the board frame, turned to world axes.
+    std::vector<Vec3> field_world_uT, p_world_m;
+    for (std::size_t i = 0; i < fields.size(); ++i)
+      if (fields[i]) {
+        field_world_uT.push_back(*fields[i]);
+        p_world_m.push_back(result.board.R_world_board *
+                            camera::camera_centre(views[i].R_camera_board, views[i].t_camera_board));
+      }
+    result.field = check_field(field_world_uT, result.site, options.field, p_world_m);
     // A disturbed compass turns the board's heading, shared by every antenna.
     result.board.covariance(2, 2) += std::pow(result.field.heading_sigma_rad, 2);
     for (const auto& w : result.field.warnings) {
@@ -763,6 +771,11 @@ nlohmann::json to_json(const NonContactResult& r) {
                            {"wmm_dip_deg", deg_or_null(f.wmm_dip_rad)},
                            {"strength_spread_percent", 100 * f.strength_spread_fraction},
                            {"dip_spread_deg", rad2deg(f.dip_spread_rad)},
+                           {"strength_trend_percent", 100 * f.strength_trend_fraction},
+                           {"strength_gradient_uT_per_m", f.strength_gradient_uT_per_m},
+                           {"trend_f_statistic", f.trend_f_statistic},
+                           {"median_dip_offset_deg",
+                            f.wmm_dip_rad ? nlohmann::json(rad2deg(f.median_dip_offset_rad)) : nlohmann::json(nullptr)},
                            {"disturbed", f.disturbed},
                            {"heading_sigma_deg", rad2deg(f.heading_sigma_rad)}};
   }
