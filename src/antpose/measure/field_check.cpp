@@ -18,47 +18,64 @@ double spread(const std::vector<double>& v) {
   return *hi - *lo;
 }
 
-// Test 4: least squares F_i = a + gᵀ(h_i − h̄) over the horizontal positions h. A walk along a line
-// leaves one slope; the SVD's rank says how many the positions fix.
-void fit_strength_gradient(const std::vector<double>& strength_uT, const std::vector<Vec3>& p_world_m, FieldCheck& c) {
-  const auto n = static_cast<Eigen::Index>(strength_uT.size());
+// Tests 4 and 5: least squares y_i = a + G(h_i − h̄) for the rows y_i (k components) over the
+// horizontal positions h. A walk along a line leaves one slope per component; the SVD's rank says
+// how many the positions fix.
+struct GradientFit {
+  double change = 0.0;       // largest distance between two photos' fitted values
+  double slope_norm = 0.0;   // |G| (Frobenius), per metre
+  double f_statistic = 0.0;  // of the slopes against the residual
+};
+
+std::optional<GradientFit> fit_gradient(const Eigen::MatrixXd& y_rows, const std::vector<Vec3>& p_world_m) {
+  const auto n = y_rows.rows(), k = y_rows.cols();
   Eigen::Vector2d mean = Eigen::Vector2d::Zero();
   for (const Vec3& p : p_world_m) mean += p.head<2>() / static_cast<double>(n);
   Eigen::MatrixXd A(n, 2);
-  Eigen::VectorXd y(n);
-  const double f_mean = Eigen::Map<const Eigen::VectorXd>(strength_uT.data(), n).mean();
-  for (Eigen::Index i = 0; i < n; ++i) {
-    A.row(i) = (p_world_m[static_cast<std::size_t>(i)].head<2>() - mean).transpose();
-    y(i) = strength_uT[static_cast<std::size_t>(i)] - f_mean;
-  }
+  for (Eigen::Index i = 0; i < n; ++i) A.row(i) = (p_world_m[static_cast<std::size_t>(i)].head<2>() - mean).transpose();
+  const Eigen::MatrixXd y = y_rows.rowwise() - y_rows.colwise().mean();
   Eigen::JacobiSVD<Eigen::MatrixXd> svd(A, Eigen::ComputeThinU | Eigen::ComputeThinV);
   svd.setThreshold(1e-3);  // slopes along less than ~0.1 % of the walk's extent are not fitted
   const auto slopes = svd.rank();
   const auto dof = n - 1 - slopes;
-  if (slopes == 0 || dof < 3) return;
-  const Eigen::Vector2d g = svd.solve(y);
-  const Eigen::VectorXd fitted = A * g;
+  if (slopes == 0 || dof < 3) return std::nullopt;
+  const Eigen::MatrixXd G = svd.solve(y);  // 2 × k
+  const Eigen::MatrixXd fitted = A * G;
   const double rss0 = y.squaredNorm(), rss1 = (y - fitted).squaredNorm();
-  c.strength_gradient_uT_per_m = g.norm();
-  c.strength_trend_fraction = (fitted.maxCoeff() - fitted.minCoeff()) / median(strength_uT);
-  c.trend_f_statistic =
-      (rss0 - rss1) / static_cast<double>(slopes) / std::max(rss1 / static_cast<double>(dof), 1e-12 * rss0 + 1e-300);
+  GradientFit fit;
+  for (Eigen::Index i = 0; i < n; ++i)
+    for (Eigen::Index j = i + 1; j < n; ++j) fit.change = std::max(fit.change, (fitted.row(i) - fitted.row(j)).norm());
+  fit.slope_norm = G.norm();
+  const double numerator = (rss0 - rss1) / static_cast<double>(slopes * k);
+  fit.f_statistic = numerator / std::max(rss1 / static_cast<double>(dof * k), 1e-12 * rss0 + 1e-300);
+  return fit;
 }
 
 }  // namespace
 
 std::vector<std::optional<Vec3>> field_at_photos(const orientation::ImuData& data,
                                                  const orientation::OrientationTrack& track,
-                                                 const std::vector<double>& t_photos, double half_window_s) {
+                                                 const std::vector<double>& t_photos,
+                                                 const std::vector<Mat3>& R_world_device, double half_window_s) {
+  if (R_world_device.size() != t_photos.size())
+    throw std::invalid_argument(
+        fmt::format("field_at_photos: {} attitudes for {} photos", R_world_device.size(), t_photos.size()));
   std::vector<std::optional<Vec3>> out;
   const auto& m = data.magnetometer;
-  for (const double t : t_photos) {
+  for (std::size_t k = 0; k < t_photos.size(); ++k) {
+    const double t = t_photos[k];
+    if (!track.contains(t)) {
+      out.emplace_back(std::nullopt);
+      continue;
+    }
+    // Each sample in the device frame at the photo's instant: R_device(t)ᵀ R_device(t_i) m_i.
+    const Eigen::Quaterniond q_photo_world = track.at(t).q_world_device.conjugate();
     Vec3 sum = Vec3::Zero();
     int n = 0;
     for (std::size_t i = 0; i < m.size(); ++i)
       if (std::abs(m.t[i] - t) <= half_window_s && track.contains(m.t[i]))
-        sum += track.at(m.t[i]).q_world_device * m.v[i], ++n;
-    out.push_back(n > 0 ? std::optional<Vec3>(sum / n) : std::nullopt);
+        sum += q_photo_world * (track.at(m.t[i]).q_world_device * m.v[i]), ++n;
+    out.push_back(n > 0 ? std::optional<Vec3>(R_world_device[k] * sum / n) : std::nullopt);
   }
   return out;
 }
@@ -69,14 +86,15 @@ FieldCheck check_field(const std::vector<Vec3>& field_world_uT, const std::optio
     throw std::invalid_argument(
         fmt::format("check_field: {} positions for {} fields", p_world_m.size(), field_world_uT.size()));
   FieldCheck c;
-  std::vector<Vec3> positions;
   for (std::size_t i = 0; i < field_world_uT.size(); ++i) {
     const Vec3& b = field_world_uT[i];
     if (!(b.norm() > 0.0)) continue;
+    c.field_world_uT.push_back(b);
     c.strength_uT.push_back(b.norm());
     c.dip_rad.push_back(std::asin(std::clamp(-b.z() / b.norm(), -1.0, 1.0)));
-    if (!p_world_m.empty()) positions.push_back(p_world_m[i]);
+    if (!p_world_m.empty()) c.p_world_m.push_back(p_world_m[i]);
   }
+  const auto& positions = c.p_world_m;
   if (c.strength_uT.empty()) return c;
   const double f_median = median(c.strength_uT), dip_median = median(c.dip_rad);
   if (site) {
@@ -96,15 +114,36 @@ FieldCheck check_field(const std::vector<Vec3>& field_world_uT, const std::optio
   c.strength_spread_fraction = spread(c.strength_uT) / f_median;
   c.dip_spread_rad = spread(c.dip_rad);
   if (site) c.median_dip_offset_rad = dip_median - site->inclination;
-  if (!positions.empty()) fit_strength_gradient(c.strength_uT, positions, c);
+  std::optional<GradientFit> vector_fit;
+  if (!positions.empty()) {
+    const auto n = static_cast<Eigen::Index>(positions.size());
+    Eigen::MatrixXd strength(n, 1), vectors(n, 3);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      strength(i, 0) = c.strength_uT[static_cast<std::size_t>(i)];
+      vectors.row(i) = c.field_world_uT[static_cast<std::size_t>(i)].transpose();
+    }
+    if (const auto fit = fit_gradient(strength, positions)) {
+      c.strength_trend_fraction = fit->change / f_median;
+      c.strength_gradient_uT_per_m = fit->slope_norm;
+      c.trend_f_statistic = fit->f_statistic;
+    }
+    if ((vector_fit = fit_gradient(vectors, positions))) {
+      c.vector_trend_fraction = vector_fit->change / f_median;
+      c.vector_trend_f_statistic = vector_fit->f_statistic;
+    }
+  }
 
   const bool off_earth = c.worst_strength_fraction > o.strength_tolerance || c.worst_dip_rad > o.dip_tolerance ||
                          std::abs(c.median_dip_offset_rad) > o.median_dip_tolerance;
   const bool trend = c.strength_trend_fraction > o.strength_trend && c.trend_f_statistic > o.trend_significance;
-  const bool uneven = c.strength_spread_fraction > o.strength_spread || c.dip_spread_rad > o.dip_spread || trend;
+  const bool vector_trend =
+      c.vector_trend_fraction > o.vector_trend && c.vector_trend_f_statistic > o.vector_trend_significance;
+  const bool uneven =
+      c.strength_spread_fraction > o.strength_spread || c.dip_spread_rad > o.dip_spread || trend || vector_trend;
   c.disturbed = off_earth || uneven;
   if (!c.disturbed) return c;
   const double horizontal = f_ref * std::cos(dip_ref);
+  if (vector_trend) seen = std::max(seen, vector_fit->change);
   c.heading_sigma_rad = seen / std::max(horizontal, 1e-3 * f_ref);
   const std::string limits = fmt::format(
       "limits {:.0f} % and {:.1f}° against WMM ({:.1f}° for the median dip), {:.1f} % and {:.1f}° over the photos",
@@ -116,10 +155,13 @@ FieldCheck check_field(const std::vector<Vec3>& field_world_uT, const std::optio
                  "{:+.1f}°), and ",
                  100 * c.worst_strength_fraction, rad2deg(c.worst_dip_rad), rad2deg(c.median_dip_offset_rad))
            : std::string();
-  const std::string along =
+  std::string along =
       trend ? fmt::format(", its strength changing by {:.1f} % along the walk ({:.2f} µT/m, limit {:.1f} %)",
                           100 * c.strength_trend_fraction, c.strength_gradient_uT_per_m, 100 * o.strength_trend)
             : std::string();
+  if (vector_trend)
+    along += fmt::format(", the field vector changing by {:.1f} % of its strength along the walk (limit {:.1f} %)",
+                         100 * c.vector_trend_fraction, 100 * o.vector_trend);
   c.warnings.push_back(fmt::format(
       "magnetic disturbance: at the photos the field {}varies between them by {:.1f} % in strength and {:.1f}° in dip "
       "({}){}: steel nearby turns the compass; the azimuth's σ includes an estimated {:.1f}°, but the error may be "

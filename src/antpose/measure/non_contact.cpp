@@ -15,6 +15,7 @@
 #include "antpose/camera/board_pose.hpp"
 #include "antpose/io/report_text.hpp"
 #include "antpose/model/sampling.hpp"
+#include "antpose/reconstruction/mast.hpp"
 
 namespace antpose::measure {
 namespace {
@@ -201,11 +202,13 @@ SilhouettePick silhouette_search(const model::AntennaModel& model, const Iso3& T
     auto r = refine(start);
     // A descent that left its start's basin still ended near a minimum: descending again from
     // there, it is kept if it stays put (then it is a minimum like any other, and the score
-    // chooses among them). Few starts sit in the right basin of a narrow panel seen face-on.
-    if (!r.converged && r.left_start) {
+    // chooses among them). Few starts sit in the right basin of a narrow panel seen face-on, and
+    // a panel partly hidden by its mast may take more than one such step to settle (1702-1).
+    for (int k = 0; k < options.silhouette_redescents && !r.converged && r.left_start; ++k) {
       ++pick.tried;
       auto again = refine(*r.left_start);
-      if (again.converged || again.score < r.score) r = std::move(again);
+      if (!again.converged && again.score >= r.score) break;
+      r = std::move(again);
     }
     if (r.converged && r.score > options.silhouette_max_score) {
       r.converged = false;
@@ -408,14 +411,51 @@ YawProfile profile_yaw(const model::AntennaModel& model, const Iso3& T_board_ant
   return profile;
 }
 
-void register_model(AntennaMeasurement& m, const model::AntennaModel& model, const Scene& scene,
+// The mast the antenna hangs on (reconstruction/mast.hpp), from the region's points beyond the
+// panel however it is turned about its axis (the points' yaw may be far off): in the photos where
+// it stands in front of the antenna it hides what lies behind it, elsewhere its edges are known
+// not to be the antenna's. The scene's photos for the outline carry it.
+Scene with_mast(AntennaMeasurement& m, const Scene& scene, const Iso3& T_antenna_board,
+                const model::AntennaModel& model, const NonContactOptions& options) {
+  if (!options.mast) return scene;
+  const double across = 0.5 * model.size_m.head<2>().norm() + options.mast_clearance_m;
+  const double along = 0.5 * model.size_m.z() + options.mast_clearance_m;
+  PointCloud beyond;
+  for (const Vec3& p : m.region.cloud_board.points) {
+    const Vec3 a = T_antenna_board * p;
+    if (a.head<2>().norm() > across || std::abs(a.z()) > along) beyond.points.push_back(p);
+  }
+  // The mast's outline is sought below the panel, where it stands alone.
+  const double bottom = scene.up_board.normalized().dot(T_antenna_board.inverse().translation()) - along;
+  auto mast = reconstruction::fit_mast(beyond, scene.up_board, scene.views, scene.intrinsics,
+                                       bottom - options.mast_outline_below_m, bottom, options.mast_options);
+  if (!mast) return scene;
+  Scene out = scene;
+  const Vec3 centre = T_antenna_board.inverse().translation();
+  for (std::size_t i = 0; i < out.outline_views.size(); ++i) {
+    auto& v = out.outline_views[i];
+    auto lines = reconstruction::mast_outline(*mast, scene.intrinsics, v.R_camera_board, v.t_camera_board);
+    if (lines[0].empty()) continue;
+    if (reconstruction::mast_in_front(*mast, scene.viewpoints[i], centre)) {
+      auto& polygon = v.occluders.emplace_back(std::move(lines[0]));
+      polygon.insert(polygon.end(), lines[1].rbegin(), lines[1].rend());
+    } else {
+      v.background_edges.push_back(std::move(lines[0]));
+      v.background_edges.push_back(std::move(lines[1]));
+    }
+  }
+  m.mast = mast;
+  return out;
+}
+
+void register_model(AntennaMeasurement& m, const model::AntennaModel& model, const Scene& site,
                     const NonContactOptions& options) {
   const PointCloud model_cloud = model::sample_surface(model.mesh_antenna, options.model_spacing_m, options.seed);
   const auto model_prepared = registration::prepare(model_cloud, options.registration.fine);
   auto gopts = options.registration;
-  gopts.viewpoints_scene = scene.viewpoints;
+  gopts.viewpoints_scene = site.viewpoints;
   const auto cloud = registration::prepare(m.region.cloud_board, gopts.fine);
-  const auto g = registration::global_align(cloud, model_prepared, scene.up_board, gopts);
+  const auto g = registration::global_align(cloud, model_prepared, site.up_board, gopts);
   Iso3 T_antenna_board = g.fit.T_target_source;
   m.method = "model " + model.name + ", points";
   m.front_back_margin = g.front_back_margin;
@@ -423,7 +463,22 @@ void register_model(AntennaMeasurement& m, const model::AntennaModel& model, con
   // The outline decides the yaw where the points cannot (docs/non-contact.md).
   std::optional<Mat3> cov_silhouette;
   if (options.silhouette) {
-    auto pick = silhouette_search(model, T_antenna_board.inverse(), scene, options);
+    auto pick = silhouette_search(model, T_antenna_board.inverse(), site, options);
+    // The mast beside the panel lures the descents away or hides part of the outline: where no
+    // start converged, the search is repeated with the mast known (with_mast). It is a second
+    // try, not the first: masking it changes every start's basin, and on 1612-3 (a panel partly
+    // behind its mast that the first try answered) it let a pose 90° off win.
+    std::optional<Scene> with_the_mast;
+    if (!pick.best) with_the_mast.emplace(with_mast(m, site, T_antenna_board, model, options));
+    const Scene& scene = with_the_mast ? *with_the_mast : site;
+    if (!pick.best && m.mast) {
+      auto known = silhouette_search(model, T_antenna_board.inverse(), scene, options);
+      known.tried += pick.tried;
+      if (known.best)
+        pick = std::move(known);
+      else
+        pick.tried = known.tried;
+    }
     // A narrow panel seen from below can trade yaw for tilt in its outline, and the mast's edges
     // beside it lure the descents away: where no start converged, the search is repeated with the
     // long axis held to the points'.
@@ -541,7 +596,7 @@ void register_model(AntennaMeasurement& m, const model::AntennaModel& model, con
         m.rivals_board.push_back(R);
     }
     if (g.front_back_ambiguous)
-      m.rivals_board.push_back(Eigen::AngleAxisd(M_PI, scene.up_board.normalized()) * m.R_board_antenna);
+      m.rivals_board.push_back(Eigen::AngleAxisd(M_PI, site.up_board.normalized()) * m.R_board_antenna);
   }
   const double covered = extent_along(m.region.cloud_board, m.R_board_antenna.col(2));
   if (covered < 0.6 * model.size_m.z())
@@ -671,9 +726,15 @@ NonContactResult measure_non_contact(const Capture& capture, const NonContactSet
   result.warnings.insert(result.warnings.end(), result.board.warnings.begin(), result.board.warnings.end());
   if (capture.site) result.site = geomag::site_field(geomag::MagneticModel::wmm2025(), *capture.site);
   if (data.has_magnetometer()) {
+    // Each photo's attitude from the board (field_check.hpp): the board's heading shared by all.
     std::vector<double> shot_t;
-    for (const auto i : result.posed) shot_t.push_back(capture.shots[i].t + setup.camera_imu.time_offset_s);
-    const auto fields = field_at_photos(data, track, shot_t, options.field.half_window_s);
+    std::vector<Mat3> R_world_device;
+    for (std::size_t i = 0; i < views.size(); ++i) {
+      shot_t.push_back(capture.shots[result.posed[i]].t + setup.camera_imu.time_offset_s);
+      R_world_device.push_back(result.board.R_world_board * views[i].R_camera_board.transpose() *
+                               setup.camera_imu.R_device_camera.transpose());
+    }
+    const auto fields = field_at_photos(data, track, shot_t, R_world_device, options.field.half_window_s);
     // Where each photo was taken: the camera centre in the board frame, turned to world axes.
     std::vector<Vec3> field_world_uT, p_world_m;
     for (std::size_t i = 0; i < fields.size(); ++i)
@@ -697,7 +758,7 @@ NonContactResult measure_non_contact(const Capture& capture, const NonContactSet
     const auto& v = views[i];
     scene.viewpoints.push_back(camera::camera_centre(v.R_camera_board, v.t_camera_board));
     auto& outline = scene.outline_views.emplace_back(
-        registration::SilhouetteView{v.image, v.R_camera_board, v.t_camera_board, {}, {}});
+        registration::SilhouetteView{v.image, v.R_camera_board, v.t_camera_board, {}, {}, {}});
     if (auto poly = board_outline(board, setup.intrinsics, v.R_camera_board, v.t_camera_board); !poly.empty())
       outline.occluders.push_back(std::move(poly));
   }
@@ -765,7 +826,12 @@ nlohmann::json to_json(const NonContactResult& r) {
     const auto& f = r.field;
     std::vector<double> dip_deg;
     for (const double d : f.dip_rad) dip_deg.push_back(rad2deg(d));
-    j["magnetic_field"] = {{"strength_uT", f.strength_uT},
+    nlohmann::json vectors = nlohmann::json::array(), positions = nlohmann::json::array();
+    for (const Vec3& b : f.field_world_uT) vectors.push_back({b.x(), b.y(), b.z()});
+    for (const Vec3& p : f.p_world_m) positions.push_back({p.x(), p.y(), p.z()});
+    j["magnetic_field"] = {{"field_world_uT", vectors},
+                           {"position_world_m", positions},
+                           {"strength_uT", f.strength_uT},
                            {"dip_deg", dip_deg},
                            {"wmm_strength_uT", f.wmm_strength_uT ? nlohmann::json(*f.wmm_strength_uT) : nullptr},
                            {"wmm_dip_deg", deg_or_null(f.wmm_dip_rad)},
@@ -774,6 +840,8 @@ nlohmann::json to_json(const NonContactResult& r) {
                            {"strength_trend_percent", 100 * f.strength_trend_fraction},
                            {"strength_gradient_uT_per_m", f.strength_gradient_uT_per_m},
                            {"trend_f_statistic", f.trend_f_statistic},
+                           {"vector_trend_percent", 100 * f.vector_trend_fraction},
+                           {"vector_trend_f_statistic", f.vector_trend_f_statistic},
                            {"median_dip_offset_deg",
                             f.wmm_dip_rad ? nlohmann::json(rad2deg(f.median_dip_offset_rad)) : nlohmann::json(nullptr)},
                            {"disturbed", f.disturbed},
@@ -806,6 +874,13 @@ nlohmann::json to_json(const NonContactResult& r) {
     a["fitness"] = ok ? nlohmann::json(m.fitness) : nullptr;
     a["front_back_margin"] = m.front_back_margin ? nlohmann::json(*m.front_back_margin) : nullptr;
     if (m.mount_points) a["mount_points"] = {{"behind", m.mount_points->behind}, {"before", m.mount_points->before}};
+    if (m.mast)
+      a["mast"] = {{"axis_point_board_m",
+                    {m.mast->axis_point_board.x(), m.mast->axis_point_board.y(), m.mast->axis_point_board.z()}},
+                   {"radius_m", m.mast->radius_m},
+                   {"points", m.mast->points},
+                   {"photos", m.mast->views},
+                   {"edge_rms_px", m.mast->edge_rms_px}};
     a["outline_rms_px"] = m.silhouette_rms_px ? nlohmann::json(*m.silhouette_rms_px) : nullptr;
     a["photos_used"] = m.region.views_used;
     a["points"] = m.region.cloud_board.size();

@@ -31,6 +31,7 @@
 #include "antpose/measure/antenna_attitude.hpp"
 #include "antpose/measure/board_world.hpp"
 #include "antpose/measure/field_check.hpp"
+#include "antpose/reconstruction/mast.hpp"
 #include "antpose/measure/model_free.hpp"
 #include "antpose/measure/mount_side.hpp"
 #include "antpose/model/antenna_model.hpp"
@@ -85,6 +86,9 @@ struct NonContactOptions {
   /// the right poses scored 0.013–0.351, the confidently wrong ones (606-3 65°, 610-1 28°,
   /// 1008-1 130° off) 0.466–0.562.
   double silhouette_max_score = 0.4;
+  /// A start whose descent left its basin is descended again from where it ended, up to this many
+  /// times, until a descent stays put (non_contact.cpp, silhouette_search).
+  int silhouette_redescents = 3;
   /// The starts already span the yaws: the refinement's own mirror restarts are left out.
   registration::SilhouetteOptions silhouette_options = [] {
     registration::SilhouetteOptions o;
@@ -137,6 +141,12 @@ struct NonContactOptions {
   /// these steps; yaws scoring within the margin of the minimum bound it.
   double held_yaw_range_deg = 40, held_yaw_step_deg = 2, held_yaw_margin = 0.05;
   MountSideOptions mount;  // the mount's side decides front and back (mount_side.hpp)
+  /// The mast as a known occluder and background for the outline (reconstruction/mast.hpp),
+  /// fitted to the region's points this far beyond the panel's box turned any way about its axis.
+  bool mast = true;
+  double mast_clearance_m = 0.03;
+  double mast_outline_below_m = 1.5;  // its outline is sought over this stretch below the panel
+  reconstruction::MastOptions mast_options;
   /// Where the mount's side cannot tell front from back, the downtilt's sign does: turning a
   /// panel round negates its downtilt, and mounts tilt panels down (tilt kits 0–15°), not up by
   /// more than this.
@@ -161,10 +171,11 @@ struct AntennaMeasurement {
   std::vector<Mat3> rivals_board;
   AntennaAttitudeResult attitude;
   double fit_rmse_m = 0.0;
-  double fitness = 0.0;                     // share of region points within reach of the model
-  std::optional<double> front_back_margin;  // model registration only
-  std::optional<double> silhouette_rms_px;  // the outline's edge RMS, when it decided the pose
-  std::optional<MountSide> mount_points;    // beyond the model, behind and before the panel, when counted
+  double fitness = 0.0;                      // share of region points within reach of the model
+  std::optional<double> front_back_margin;   // model registration only
+  std::optional<double> silhouette_rms_px;   // the outline's edge RMS, when it decided the pose
+  std::optional<MountSide> mount_points;     // beyond the model, behind and before the panel, when counted
+  std::optional<reconstruction::Mast> mast;  // the mast found beside it, if any (the outline's occluder)
   reconstruction::RegionReconstruction region;
   PointCloud model_board;  // the registered model's samples, board frame (report)
   std::vector<std::string> warnings;

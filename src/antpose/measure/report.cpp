@@ -52,6 +52,14 @@ void draw_overlay(cv::Mat& image, double scale, const camera::CameraIntrinsics& 
       if (pa && pb)
         cv::line(image, *pa, *pb, front ? cv::Scalar(0, 230, 0) : cv::Scalar(0, 140, 255), thickness, cv::LINE_AA);
     }
+  // The mast found beside it (the outline's occluder or masked background), magenta.
+  if (m.mast)
+    for (const auto& line : reconstruction::mast_outline(*m.mast, in, R_cb, t_cb)) {
+      std::vector<cv::Point> pts;
+      for (const auto& q : line)
+        pts.emplace_back(static_cast<int>(std::lround(q.x * scale)), static_cast<int>(std::lround(q.y * scale)));
+      if (pts.size() >= 2) cv::polylines(image, pts, false, cv::Scalar(255, 0, 255), thickness, cv::LINE_AA);
+    }
   const Vec3 face(0.0, hi.y(), 0.0);
   const auto p0 = px(face), p1 = px(face + Vec3(0.0, 0.5 * (hi.z() - lo.z()), 0.0));
   if (p0 && p1) cv::arrowedLine(image, *p0, *p1, cv::Scalar(0, 255, 255), thickness, cv::LINE_AA, 0, 0.15);
@@ -88,6 +96,11 @@ std::string plan_svg(const AntennaMeasurement& m, const BoardWorldAttitude& boar
         svg += fmt::format(R"(<circle cx="{:.1f}" cy="{:.1f}" r="1.2" fill="{}"/>)", x, y, colour);
     }
   };
+  if (m.mast) {
+    const auto [x, y] = xy(m.mast->axis_point_board);
+    svg += fmt::format(R"(<circle cx="{:.1f}" cy="{:.1f}" r="{:.1f}" fill="none" stroke="#c020c0" stroke-width="2"/>)",
+                       x, y, s * m.mast->radius_m);
+  }
   dots(m.model_board, "#f0a040");
   dots(m.region.cloud_board, "#2060c0");
   const Vec3 b = R_wb * m.R_board_antenna.col(1);
@@ -97,7 +110,7 @@ std::string plan_svg(const AntennaMeasurement& m, const BoardWorldAttitude& boar
   svg +=
       R"(<line x1="30" y1="60" x2="30" y2="15" stroke="black" stroke-width="2"/><text x="25" y="12" font-size="12">N</text>)";
   svg += fmt::format(
-      R"(<text x="8" y="{}" font-size="11">1 m ┤ blue: points, orange: model, red: boresight (magnetic)</text>)",
+      R"(<text x="8" y="{}" font-size="11">1 m ┤ blue: points, orange: model, red: boresight (magnetic), magenta: mast</text>)",
       size - 8);
   return svg + "</svg>";
 }
@@ -184,7 +197,7 @@ std::string html_page(const Capture& capture, const NonContactResult& r, const s
                        plan_svg(r.antennas[k], r.board), k + 1);
   h += "<h2>Board attitude per photo</h2>" + residual_svg(r.board);
   h += "<h2>Photos with the registered model</h2><p>Green: the front (radome) face; orange: the rest of the box; "
-       "yellow: the boresight.</p>";
+       "yellow: the boresight; magenta: the mast found beside it.</p>";
   for (const auto& o : overlays) h += fmt::format("<a href=\"{0}\"><img src=\"{0}\"></a>", o);
   if (!r.skipped.empty()) {
     h += "<h2>Photos not used</h2><ul>";

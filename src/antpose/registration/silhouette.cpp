@@ -10,6 +10,7 @@
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "antpose/camera/edge_search.hpp"
 #include "antpose/core/statistics.hpp"
 
 namespace antpose::registration {
@@ -77,17 +78,42 @@ struct PreparedView {
   Vec3 t_cb = Vec3::Zero();
   Vec2 offset = Vec2::Zero();  // crop origin, full-resolution px
   cv::Size size;
-  std::vector<cv::Mat> gx, gy;                      // CV_32F per level
-  std::vector<std::vector<cv::Point2f>> occluders;  // full-resolution px
+  std::vector<cv::Mat> gx, gy;  // CV_32F per level, 0 where masked
+  // Per level (empty without occluders or background edges): 255 where the antenna's outline
+  // cannot be seen — on a nearer object, on a known object's edge, or within the edge's blur.
+  std::vector<cv::Mat> mask;
 };
 
-// Whether an outline point lies on a known nearer object or within `margin_px` of its border
-// (whose edge the search would take for the antenna's).
-bool occluded(const PreparedView& v, const Vec2& p, double margin_px) {
-  const cv::Point2f q(static_cast<float>(p.x()), static_cast<float>(p.y()));
-  for (const auto& poly : v.occluders)
-    if (cv::pointPolygonTest(poly, q, true) >= -margin_px) return true;
-  return false;
+// Whether an outline point at `p` (full-resolution px) falls on the view's mask at `level`.
+bool masked(const PreparedView& v, int level, const Vec2& p) {
+  if (v.mask.empty()) return false;
+  const Vec2 q = (p - v.offset) / std::ldexp(1.0, level);
+  const int x = static_cast<int>(std::lround(q.x())), y = static_cast<int>(std::lround(q.y()));
+  const cv::Mat& m = v.mask[static_cast<std::size_t>(level)];
+  return x >= 0 && y >= 0 && x < m.cols && y < m.rows && m.at<std::uint8_t>(y, x) != 0;
+}
+
+// The view's mask at one level: the occluders filled, the background edges drawn, both widened
+// by `guard_px` (the level's px) so that their blurred edges cannot be taken for the antenna's.
+cv::Mat level_mask(const SilhouetteView& in, const Vec2& offset, cv::Size size, int level, double guard_px) {
+  cv::Mat m = cv::Mat::zeros(size, CV_8UC1);
+  const double s = std::ldexp(1.0, -level);
+  constexpr int kShift = 2;  // quarter-pixel vertices
+  const auto to_level = [&](const std::vector<cv::Point2f>& poly) {
+    std::vector<cv::Point> out;
+    for (const auto& p : poly)
+      out.emplace_back(static_cast<int>(std::lround((p.x - offset.x()) * s * (1 << kShift))),
+                       static_cast<int>(std::lround((p.y - offset.y()) * s * (1 << kShift))));
+    return out;
+  };
+  for (const auto& poly : in.occluders)
+    if (poly.size() >= 3) cv::fillPoly(m, std::vector<std::vector<cv::Point>>{to_level(poly)}, 255, cv::LINE_8, kShift);
+  for (const auto& line : in.background_edges)
+    if (line.size() >= 2)
+      cv::polylines(m, std::vector<std::vector<cv::Point>>{to_level(line)}, false, 255, 1, cv::LINE_8, kShift);
+  const int r = static_cast<int>(std::ceil(guard_px));
+  cv::dilate(m, m, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * r + 1, 2 * r + 1)));
+  return m;
 }
 
 struct Sample {
@@ -97,15 +123,6 @@ struct Sample {
   std::uint32_t edge = 0;         // the mesh edge it lies on (correlated errors, see covariance)
   double px_per_m = 0;            // f / depth: image size of a model shape error
 };
-
-float bilinear(const cv::Mat& m, double x, double y) {
-  const int x0 = static_cast<int>(std::floor(x)), y0 = static_cast<int>(std::floor(y));
-  if (x0 < 0 || y0 < 0 || x0 + 1 >= m.cols || y0 + 1 >= m.rows) return 0.f;
-  const float fx = static_cast<float>(x - x0), fy = static_cast<float>(y - y0);
-  const float* r0 = m.ptr<float>(y0);
-  const float* r1 = m.ptr<float>(y0 + 1);
-  return (1 - fy) * ((1 - fx) * r0[x0] + fx * r0[x0 + 1]) + fy * ((1 - fx) * r1[x0] + fx * r1[x0 + 1]);
-}
 
 std::optional<Vec2> project(const camera::CameraIntrinsics& K, const PreparedView& v, const Vec3& p_board) {
   const Vec3 c = v.R_cb * p_board + v.t_cb;
@@ -180,9 +197,7 @@ void gather(const EdgeMesh& m, const Pose& pose, const PreparedView& v, const ca
 
   const cv::Mat& gx = v.gx[level];
   const cv::Mat& gy = v.gy[level];
-  const double step = 0.5;
-  const int half = static_cast<int>(std::ceil(search_px / step));
-  std::vector<double> g(2 * half + 1);
+  std::vector<double> g;
   const double spacing = o.sample_spacing_px * scale;
   for (std::size_t ei = 0; ei < m.edges.size(); ++ei) {
     const auto& e = m.edges[ei];
@@ -206,33 +221,21 @@ void gather(const EdgeMesh& m, const Pose& pose, const PreparedView& v, const ca
       const bool in_minus = inside(q - k * normal), in_plus = inside(q + k * normal);
       if (in_minus == in_plus) continue;  // inner edge, or hidden by another part of the model
       if (in_plus) normal = -normal;
-      if (!v.occluders.empty() && occluded(v, *p, (search_px + 2) * scale)) continue;
+      if (masked(v, level, *p)) continue;  // hidden, or where a known object's edge would be taken for it
       ++candidates;
       const Vec2 in_crop = *p - v.offset;
       if (in_crop.x() < 0 || in_crop.y() < 0 || in_crop.x() > v.size.width - 1 || in_crop.y() > v.size.height - 1) {
         ++outside;
         continue;
       }
-      // 1-D search along the normal for the nearest strong edge (Drummond & Cipolla 2002).
-      const Vec2 c = (*p - v.offset) / scale;
-      double gmax = 0;
-      for (int i = -half; i <= half; ++i) {
-        const Vec2 z = c + (i * step) * normal;
-        g[i + half] = std::abs(bilinear(gx, z.x(), z.y()) * normal.x() + bilinear(gy, z.x(), z.y()) * normal.y());
-        gmax = std::max(gmax, g[i + half]);
-      }
-      if (gmax < o.min_edge_gradient) continue;
-      int best = -1;
-      for (int i = 1; i + 1 < static_cast<int>(g.size()); ++i) {
-        if (g[i] < 0.5 * gmax || g[i] < o.min_edge_gradient || g[i] < g[i - 1] || g[i] < g[i + 1]) continue;
-        if (best < 0 || std::abs(i - half) < std::abs(best - half)) best = i;
-      }
-      if (best < 0) continue;
-      const double den = g[best - 1] - 2 * g[best] + g[best + 1];
-      const double sub = den < 0 ? std::clamp(0.5 * (g[best - 1] - g[best + 1]) / den, -0.5, 0.5) : 0.0;
+      // 1-D search along the normal for the nearest strong edge (Drummond & Cipolla 2002); the
+      // masked parts' gradients are 0, so a nearer object's edge is never taken.
+      const auto edge =
+          camera::nearest_edge(gx, gy, (*p - v.offset) / scale, normal, search_px, o.min_edge_gradient, g);
+      if (!edge) continue;
       Sample smp;
       smp.normal = normal;
-      smp.r = ((best - half) + sub) * step * scale;
+      smp.r = *edge * scale;
       // Jacobian of the projection by central differences in the camera frame (distortion included).
       const Vec3 Xc = v.R_cb * X + v.t_cb;
       Eigen::Matrix<double, 2, 3> dp;
@@ -406,7 +409,6 @@ SilhouetteResult refine_by_silhouette(const model::Mesh& mesh_antenna, const Iso
                                               intrinsics.width, intrinsics.height));
     auto& v = prepared[i];
     v.R_cb = in.R_camera_board;
-    v.occluders = in.occluders;
     v.t_cb = in.t_camera_board;
     const auto box = projected_box(intrinsics, v, m, pose);
     if (!box) {
@@ -442,26 +444,22 @@ SilhouetteResult refine_by_silhouette(const model::Mesh& mesh_antenna, const Iso
       if (!v.usable) continue;
       const cv::Mat crop = views[i].image(
           cv::Rect(static_cast<int>(v.offset.x()), static_cast<int>(v.offset.y()), v.size.width, v.size.height));
-      // Edges are located in linear intensity: a gamma-encoded blurred step has its steepest point
-      // shifted towards the dark side, which would bias the outline's width and so the yaw.
-      cv::Mat level;
-      if (options.gamma > 0) {
-        cv::Mat lut(1, 256, CV_32F);
-        for (int k = 0; k < 256; ++k) lut.at<float>(k) = static_cast<float>(255.0 * std::pow(k / 255.0, options.gamma));
-        cv::LUT(crop, lut, level);
-      } else {
-        crop.convertTo(level, CV_32F);
-      }
+      // Edges are located in linear intensity (camera/edge_search.hpp): in encoded values the
+      // outline's width, and so the yaw, would be biased.
+      cv::Mat level = camera::linear_intensity(crop, options.gamma);
+      const bool with_mask = !views[i].occluders.empty() || !views[i].background_edges.empty();
       for (int l = 0; l <= top; ++l) {
         if (l > 0) {
           cv::Mat down;
           cv::pyrDown(level, down);
           level = down;
         }
-        cv::Mat f, gx, gy;
-        cv::GaussianBlur(level, f, cv::Size(), options.smoothing_sigma_px);
-        cv::Sobel(f, gx, CV_32F, 1, 0, 3, 1.0 / 8.0);
-        cv::Sobel(f, gy, CV_32F, 0, 1, 3, 1.0 / 8.0);
+        auto [gx, gy] = camera::smoothed_gradients(level, options.smoothing_sigma_px);
+        if (with_mask) {
+          v.mask.push_back(level_mask(views[i], v.offset, level.size(), l, options.mask_guard_px));
+          gx.setTo(0, v.mask.back());
+          gy.setTo(0, v.mask.back());
+        }
         v.gx.push_back(gx);
         v.gy.push_back(gy);
       }

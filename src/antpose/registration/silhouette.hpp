@@ -21,7 +21,8 @@
 // searches on blurred images first (inner shading gone), ±4 px last. Optionally a monotone
 // descent at full resolution: a step that raises the score is halved, as a line search would
 // (Nocedal & Wright, Numerical Optimization, ch. 3), and none lowering it ends the descent.
-// Scene edges not in the model (clamp arms, mast, board) are down-weighted by the robust loss.
+// Scene edges not in the model (clamp arms, mast, board) are down-weighted by the robust loss;
+// known objects (the board, a mast fitted to the scene) are masked out of the search instead.
 // Edges are searched in linear intensity (the photo's gamma undone): in encoded values a blurred
 // step's steepest point moves towards its dark side, biasing the outline's width and so the yaw.
 //
@@ -59,9 +60,15 @@ struct SilhouetteView {
   /// Crop (px) holding the antenna's whole outline plus the search range; else the start's
   /// projected bounding box + margin (the normal choice).
   std::optional<cv::Rect> roi;
-  /// Known objects nearer than the antenna (the calibration board), as image polygons (px, as
-  /// taken): outline points on them or within the search range of their border are not used.
+  /// Known objects nearer than the antenna (the calibration board, a mast in front of it), as
+  /// image polygons (px, as taken): outline points on them are hidden and not used, and the
+  /// edge search does not look into them (nor within mask_guard_px of their border), so their
+  /// border is never taken for the antenna's outline.
   std::vector<std::vector<cv::Point2f>> occluders;
+  /// Known edges of other objects (a mast behind the antenna), as image polylines (px, as
+  /// taken): within mask_guard_px of them the antenna's outline cannot be told from theirs, and
+  /// neither outline points nor edges there are used.
+  std::vector<std::vector<cv::Point2f>> background_edges;
 };
 
 struct SilhouetteOptions {
@@ -83,6 +90,7 @@ struct SilhouetteOptions {
   double max_step_rotation_rad = deg2rad(5.0);
   double tukey_c = 4.685;             // × robust σ (MAD), σ ≥ 0.5 px of the level
   double roi_margin_px = 40;          // around the projected model (plus 10 % of its size)
+  double mask_guard_px = 3;           // occluders and background edges widened by this, per level
   double correlation_length_px = 12;  // covariance inflation (see the file comment)
   double shape_tolerance_m = 0.001;   // model vs real panel, per mesh edge (covariance)
   double edge_bias_px = 0.1;          // edge-localisation bias per mesh edge, all views (covariance)

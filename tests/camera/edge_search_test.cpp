@@ -1,0 +1,71 @@
+#include "antpose/camera/edge_search.hpp"
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
+
+namespace antpose::camera {
+namespace {
+
+// A photo of a vertical step from dark to light at x = edge (px; pixel centres at integers, so a
+// pixel straddling the edge is mixed): linear radiance blurred by the optics, then encoded with a
+// gamma of 2.2 as a phone does.
+cv::Mat step_image(double edge, int width = 80, int height = 40) {
+  cv::Mat radiance(height, width, CV_32F);
+  for (int x = 0; x < width; ++x) {
+    const double cover = std::clamp(x + 0.5 - edge, 0.0, 1.0);  // share of pixel x right of the edge
+    radiance.col(x).setTo(cv::Scalar(0.05 + 0.75 * cover));
+  }
+  cv::GaussianBlur(radiance, radiance, cv::Size(), 0.8);
+  cv::Mat encoded;
+  cv::pow(radiance, 1.0 / 2.2, encoded);
+  encoded.convertTo(encoded, CV_8UC1, 255.0);
+  return encoded;
+}
+
+// Half-pixel samples of bilinearly interpolated gradients and a parabola through the peak: the
+// position is biased towards the samples by up to a quarter pixel, which averages out over an
+// outline's many samples at random phases.
+TEST(EdgeSearch, FindsAStepToAQuarterPixelInLinearIntensity) {
+  std::vector<double> scratch;
+  for (const double edge : {30.0, 30.25, 30.5, 31.8}) {
+    const auto [gx, gy] = smoothed_gradients(linear_intensity(step_image(edge), 2.2), 1.0);
+    // From left and right of the edge, along +x: the signed distance to it.
+    for (const double from : {24.0, 36.0}) {
+      const auto d = nearest_edge(gx, gy, Vec2(from, 20.0), Vec2(1.0, 0.0), 10.0, 3.0, scratch);
+      ASSERT_TRUE(d.has_value()) << edge << " " << from;
+      EXPECT_NEAR(from + *d, edge, 0.27) << edge << " " << from;
+    }
+    // Out of reach, or along the edge: none.
+    EXPECT_FALSE(nearest_edge(gx, gy, Vec2(10.0, 20.0), Vec2(1.0, 0.0), 5.0, 3.0, scratch).has_value());
+    EXPECT_FALSE(nearest_edge(gx, gy, Vec2(30.0, 20.0), Vec2(0.0, 1.0), 10.0, 3.0, scratch).has_value());
+  }
+}
+
+// Of two edges the nearer strong one wins, a weak one (below half the strongest) never; where
+// the gradients are zeroed (a masked object), nothing is found there. The steps are sharp (the
+// bilinear samples of a sharp gradient peak have a flat top, so a quarter pixel is as close as
+// it gets).
+TEST(EdgeSearch, TakesTheNearestStrongEdgeAndNeverAMaskedOne) {
+  cv::Mat m(40, 100, CV_8UC1, cv::Scalar(40));
+  m.colRange(30, 100).setTo(200);  // strong step at 29.5
+  m.colRange(60, 100).setTo(230);  // weak step at 59.5
+  m.colRange(70, 100).setTo(20);   // strong step at 69.5
+  auto [gx, gy] = smoothed_gradients(linear_intensity(m, 0.0), 1.0);
+  std::vector<double> scratch;
+  const auto nearest = [&](double x) {
+    return nearest_edge(gx, gy, Vec2(x, 20.0), Vec2(1.0, 0.0), 25.0, 3.0, scratch);
+  };
+  ASSERT_TRUE(nearest(45.0).has_value());
+  EXPECT_NEAR(45.0 + *nearest(45.0), 29.5, 0.3);  // 15.5 px left; the weak step 14.5 px right is ignored
+  EXPECT_NEAR(52.0 + *nearest(52.0), 69.5, 0.3);
+  cv::Mat mask = cv::Mat::zeros(gx.size(), CV_8UC1);
+  mask.colRange(64, 76).setTo(255);
+  gx.setTo(0, mask), gy.setTo(0, mask);
+  ASSERT_TRUE(nearest(52.0).has_value());
+  EXPECT_NEAR(52.0 + *nearest(52.0), 29.5, 0.3);  // the masked step is not there any more
+}
+
+}  // namespace
+}  // namespace antpose::camera
