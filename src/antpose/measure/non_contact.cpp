@@ -11,9 +11,11 @@
 #include <fmt/ranges.h>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "antpose/camera/board_pose.hpp"
 #include "antpose/io/report_text.hpp"
+#include "antpose/model/box_file.hpp"
 #include "antpose/model/sampling.hpp"
 #include "antpose/reconstruction/mast.hpp"
 
@@ -89,6 +91,12 @@ double extent_along(const PointCloud& cloud, const Vec3& axis) {
   for (const auto& p : cloud.points) lo = std::min(lo, p.dot(axis)), hi = std::max(hi, p.dot(axis));
   return cloud.empty() ? 0.0 : hi - lo;
 }
+
+// The outline fitted from no start: the antenna may be tried again once its neighbours are known.
+class OutlineNotFound : public MeasurementError {
+ public:
+  using MeasurementError::MeasurementError;
+};
 
 // What the registration of every antenna shares.
 struct Scene {
@@ -448,6 +456,44 @@ Scene with_mast(AntennaMeasurement& m, const Scene& scene, const Iso3& T_antenna
   return out;
 }
 
+// The other antennas already registered, as known objects in the photos of antenna k: each one's
+// box, projected (the hull of its corners), is an occluder where it stands nearer the camera than
+// k's points, elsewhere its outline is a masked edge. On a mast with three sectors the front
+// panel's outline runs along the faces of the two behind it (1805-3, the thesis panel seen
+// face-on between two wider ones).
+Scene with_other_antennas(const Scene& scene, const std::vector<AntennaMeasurement>& antennas,
+                          const NonContactSetup& setup, std::size_t k) {
+  Scene out = scene;
+  const auto& cloud = antennas[k].region.cloud_board;
+  if (cloud.empty()) return out;
+  Vec3 centre = Vec3::Zero();
+  for (const Vec3& p : cloud.points) centre += p / static_cast<double>(cloud.size());
+  for (std::size_t j = 0; j < antennas.size(); ++j) {
+    const auto* model = setup.model_for(j);
+    if (j == k || antennas[j].error || !model) continue;
+    const auto& other = antennas[j];
+    for (std::size_t i = 0; i < out.outline_views.size(); ++i) {
+      auto& v = out.outline_views[i];
+      std::vector<cv::Point2f> corners;
+      for (const Vec3& c : model::box_corners(model->size_m))
+        if (const auto uv = scene.intrinsics.project(
+                v.R_camera_board * (other.R_board_antenna * c + other.p_board_antenna) + v.t_camera_board))
+          corners.emplace_back(static_cast<float>(uv->x()), static_cast<float>(uv->y()));
+      if (corners.size() < 8) continue;
+      std::vector<cv::Point2f> hull;
+      cv::convexHull(corners, hull);
+      const Vec3& camera = scene.viewpoints[i];
+      if ((other.p_board_antenna - camera).norm() < (centre - camera).norm()) {
+        v.occluders.push_back(std::move(hull));
+      } else {
+        hull.push_back(hull.front());
+        v.background_edges.push_back(std::move(hull));
+      }
+    }
+  }
+  return out;
+}
+
 void register_model(AntennaMeasurement& m, const model::AntennaModel& model, const Scene& site,
                     const NonContactOptions& options) {
   const PointCloud model_cloud = model::sample_surface(model.mesh_antenna, options.model_spacing_m, options.seed);
@@ -496,7 +542,7 @@ void register_model(AntennaMeasurement& m, const model::AntennaModel& model, con
     if (!pick.best)
       // On the acceptance captures the points alone were tens of degrees off in yaw whenever the
       // outline failed: no number is better than that one.
-      throw MeasurementError(fmt::format(
+      throw OutlineNotFound(fmt::format(
           "the model's outline matched the photos from none of {} starts, and the points alone do not fix the "
           "panel's yaw: is the whole antenna inside the photos, free of other panels in front of it, and is the "
           "model this antenna's? (closest start: {})",
@@ -766,6 +812,12 @@ NonContactResult measure_non_contact(const Capture& capture, const NonContactSet
   auto region_options = options.region;
   region_options.exclude_board = board;
 
+  const auto finish = [&](AntennaMeasurement& m) {
+    m.cov_board += cov_poses;
+    m.attitude = antenna_attitude(result.board, m.R_board_antenna, m.cov_board, result.site);
+    widen_for_rivals(m, result.board, result.site);
+  };
+  std::vector<std::size_t> retry;  // outline from no start: tried again with the others known
   for (std::size_t k = 0; k < setup.rois.size(); ++k) {
     AntennaMeasurement m;
     m.roi = setup.rois[k];
@@ -796,13 +848,34 @@ NonContactResult measure_non_contact(const Capture& capture, const NonContactSet
         for (const auto& w : fit.warnings) m.warnings.push_back(w);
       }
       report(options, name + ": registration", 1, 1);
-      m.cov_board += cov_poses;
-      m.attitude = antenna_attitude(result.board, m.R_board_antenna, m.cov_board, result.site);
-      widen_for_rivals(m, result.board, result.site);
+      finish(m);
+    } catch (const OutlineNotFound& e) {
+      m.error = e.what();
+      retry.push_back(k);
     } catch (const MeasurementError& e) {
       m.error = e.what();
     }
     result.antennas.push_back(std::move(m));
+  }
+  // Antennas whose outline fitted from no start, again with the others registered known.
+  for (const std::size_t k : retry) {
+    auto& m = result.antennas[k];
+    const bool others = std::any_of(result.antennas.begin(), result.antennas.end(),
+                                    [&](const AntennaMeasurement& a) { return &a != &m && !a.error; });
+    if (!others) continue;
+    AntennaMeasurement again;
+    again.roi = m.roi;
+    again.region = m.region;
+    again.warnings = m.region.warnings;
+    try {
+      register_model(again, *setup.model_for(k), with_other_antennas(scene, result.antennas, setup, k), options);
+      again.warnings.push_back(
+          "the outline fitted only with the other antennas' registered outlines known (their edges masked)");
+      finish(again);
+      m = std::move(again);
+    } catch (const MeasurementError& e) {
+      m.error = fmt::format("{} (and again with the other antennas known: {})", *m.error, e.what());
+    }
   }
   return result;
 }
