@@ -510,24 +510,15 @@ void register_model(AntennaMeasurement& m, const model::AntennaModel& model, con
   std::optional<Mat3> cov_silhouette;
   if (options.silhouette) {
     auto pick = silhouette_search(model, T_antenna_board.inverse(), site, options);
-    // The mast beside the panel lures the descents away or hides part of the outline: where no
-    // start converged, the search is repeated with the mast known (with_mast). It is a second
-    // try, not the first: masking it changes every start's basin, and on 1612-3 (a panel partly
-    // behind its mast that the first try answered) it let a pose 90° off win.
+    // A narrow panel seen from below can trade yaw for tilt in its outline, and the mast's edges
+    // beside it lure the descents away or the mast hides part of it: where no start converged,
+    // the search is repeated with the long axis held to the points' and the mast known
+    // (with_mast), its yaw then bounded by the outline's profile. The mast is not known to the
+    // first search: masking it changes every start's basin, and there it let poses 43–90° off
+    // win with small σ (1612-3, 2004-2, 1702-1, 610-1; docs/non-contact.md).
     std::optional<Scene> with_the_mast;
     if (!pick.best) with_the_mast.emplace(with_mast(m, site, T_antenna_board, model, options));
     const Scene& scene = with_the_mast ? *with_the_mast : site;
-    if (!pick.best && m.mast) {
-      auto known = silhouette_search(model, T_antenna_board.inverse(), scene, options);
-      known.tried += pick.tried;
-      if (known.best)
-        pick = std::move(known);
-      else
-        pick.tried = known.tried;
-    }
-    // A narrow panel seen from below can trade yaw for tilt in its outline, and the mast's edges
-    // beside it lure the descents away: where no start converged, the search is repeated with the
-    // long axis held to the points'.
     std::optional<Vec3> held_axis;
     if (!pick.best && options.held_axis_search) {
       held_axis = points_long_axis(cloud, model_prepared, T_antenna_board, options);

@@ -87,8 +87,9 @@ struct NonContactOptions {
   /// 1008-1 130° off) 0.466–0.562.
   double silhouette_max_score = 0.4;
   /// A start whose descent left its basin is descended again from where it ended, up to this many
-  /// times, until a descent stays put (non_contact.cpp, silhouette_search).
-  int silhouette_redescents = 3;
+  /// times, until a descent stays put (non_contact.cpp, silhouette_search). More than once let a
+  /// start far from the truth settle in a wrong basin that scored best (606-3, 52° off).
+  int silhouette_redescents = 1;
   /// The starts already span the yaws: the refinement's own mirror restarts are left out.
   registration::SilhouetteOptions silhouette_options = [] {
     registration::SilhouetteOptions o;
