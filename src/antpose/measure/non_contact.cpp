@@ -494,8 +494,12 @@ Scene with_other_antennas(const Scene& scene, const std::vector<AntennaMeasureme
   return out;
 }
 
+// Which outline searches run: all of them on the first pass; on a second pass, with more objects
+// known in the photos, only the held-axis search (see its use below for why).
+enum class OutlinePass { kFirst, kHeldAxisOnly };
+
 void register_model(AntennaMeasurement& m, const model::AntennaModel& model, const Scene& site,
-                    const NonContactOptions& options) {
+                    const NonContactOptions& options, OutlinePass pass = OutlinePass::kFirst) {
   const PointCloud model_cloud = model::sample_surface(model.mesh_antenna, options.model_spacing_m, options.seed);
   const auto model_prepared = registration::prepare(model_cloud, options.registration.fine);
   auto gopts = options.registration;
@@ -509,13 +513,16 @@ void register_model(AntennaMeasurement& m, const model::AntennaModel& model, con
   // The outline decides the yaw where the points cannot (docs/non-contact.md).
   std::optional<Mat3> cov_silhouette;
   if (options.silhouette) {
-    auto pick = silhouette_search(model, T_antenna_board.inverse(), site, options);
+    // Known objects (the mast, the other antennas) change every start's basin: in the free
+    // search they let poses 43–90° off win with small σ (1612-3, 2004-2, 1702-1, 610-1 with the
+    // mast; 2106-1 with the other panels, −55° and the tilt −3.2° with σ 0.24°), so they are known
+    // only to the held-axis search, whose yaw the outline's profile then bounds.
+    auto pick = pass == OutlinePass::kFirst ? silhouette_search(model, T_antenna_board.inverse(), site, options)
+                                            : SilhouettePick{};
     // A narrow panel seen from below can trade yaw for tilt in its outline, and the mast's edges
     // beside it lure the descents away or the mast hides part of it: where no start converged,
     // the search is repeated with the long axis held to the points' and the mast known
-    // (with_mast), its yaw then bounded by the outline's profile. The mast is not known to the
-    // first search: masking it changes every start's basin, and there it let poses 43–90° off
-    // win with small σ (1612-3, 2004-2, 1702-1, 610-1; docs/non-contact.md).
+    // (with_mast), its yaw then bounded by the outline's profile.
     std::optional<Scene> with_the_mast;
     if (!pick.best) with_the_mast.emplace(with_mast(m, site, T_antenna_board, model, options));
     const Scene& scene = with_the_mast ? *with_the_mast : site;
@@ -853,13 +860,14 @@ NonContactResult measure_non_contact(const Capture& capture, const NonContactSet
     auto& m = result.antennas[k];
     const bool others = std::any_of(result.antennas.begin(), result.antennas.end(),
                                     [&](const AntennaMeasurement& a) { return &a != &m && !a.error; });
-    if (!others) continue;
+    if (!others || !options.held_axis_search) continue;
     AntennaMeasurement again;
     again.roi = m.roi;
     again.region = m.region;
     again.warnings = m.region.warnings;
     try {
-      register_model(again, *setup.model_for(k), with_other_antennas(scene, result.antennas, setup, k), options);
+      register_model(again, *setup.model_for(k), with_other_antennas(scene, result.antennas, setup, k), options,
+                     OutlinePass::kHeldAxisOnly);
       again.warnings.push_back(
           "the outline fitted only with the other antennas' registered outlines known (their edges masked)");
       finish(again);
