@@ -339,6 +339,7 @@ void decide_front_by_mount(AntennaMeasurement& m, SilhouettePick& pick, const mo
 // covariance (board frame) to use, or nothing when the outline's own stands.
 std::optional<Mat3> hold_axis_to_points(AntennaMeasurement& m, Iso3& T_antenna_board, const Mat3& cov_outline,
                                         const model::AntennaModel& model, const Vec3& axis_points, const Scene& scene,
+                                        const std::function<bool(const Iso3&)>& fits_points,
                                         const NonContactOptions& options) {
   const Mat3 R_outline = T_antenna_board.rotation().transpose();
   const double disagreement = angle_between(R_outline.col(2), axis_points);
@@ -357,7 +358,7 @@ std::optional<Mat3> hold_axis_to_points(AntennaMeasurement& m, Iso3& T_antenna_b
   // right), so the downtilt and roll σ cover both, as a two-way mixture: half the disagreement.
   const double sa = deg2rad(options.points_axis_sigma_deg);
   const Mat3 both = across_long_axis(R, sa * sa + std::pow(disagreement / 2, 2));
-  if (r.converged) {
+  if (r.converged && fits_points(r.T_board_antenna.inverse())) {
     m.warnings.push_back(fmt::format(
         "the outline's long axis lay {:.1f}° from the points' (seen from below it can slide along the line of "
         "sight): the points' axis is kept, the outline fixes the yaw about it, and the downtilt and roll σ cover "
@@ -494,6 +495,28 @@ Scene with_other_antennas(const Scene& scene, const std::vector<AntennaMeasureme
   return out;
 }
 
+// The share of `cloud` (board frame) within `reach` of the model at T_antenna_board, and the RMS
+// distance of those points.
+struct PointsFit {
+  double fitness = 0.0;
+  double rmse_m = std::numeric_limits<double>::infinity();
+};
+
+PointsFit points_fit(const PointCloud& cloud, const registration::KdTree& model, const Iso3& T_antenna_board,
+                     double reach) {
+  double ss = 0.0;
+  std::size_t near = 0;
+  for (const auto& p : cloud.points) {
+    std::size_t index = 0;
+    double d2 = 0.0;
+    if (model.nearest(T_antenna_board * p, index, d2) && d2 <= reach * reach) ss += d2, ++near;
+  }
+  PointsFit fit;
+  if (!cloud.empty()) fit.fitness = static_cast<double>(near) / static_cast<double>(cloud.size());
+  if (near) fit.rmse_m = std::sqrt(ss / static_cast<double>(near));
+  return fit;
+}
+
 // Which outline searches run: all of them on the first pass; on a second pass, with more objects
 // known in the photos, only the held-axis search (see its use below for why).
 enum class OutlinePass { kFirst, kHeldAxisOnly };
@@ -507,6 +530,13 @@ void register_model(AntennaMeasurement& m, const model::AntennaModel& model, con
   const auto cloud = registration::prepare(m.region.cloud_board, gopts.fine);
   const auto g = registration::global_align(cloud, model_prepared, site.up_board, gopts);
   Iso3 T_antenna_board = g.fit.T_target_source;
+  const double reach = gopts.fine.max_correspondence_distance_m;
+  // The outline has fitted something else where its pose leaves far fewer points near the model
+  // than the points' own pose does (options.outline_points_fit_ratio).
+  const auto fits_points = [&](const Iso3& T) {
+    return points_fit(m.region.cloud_board, model_prepared.tree, T, reach).fitness >=
+           options.outline_points_fit_ratio * g.fit.fitness;
+  };
   m.method = "model " + model.name + ", points";
   m.front_back_margin = g.front_back_margin;
 
@@ -589,23 +619,16 @@ void register_model(AntennaMeasurement& m, const model::AntennaModel& model, con
           "clearly better the other way round)");
     if (!held_axis)
       if (const auto held =
-              hold_axis_to_points(m, T_antenna_board, *cov_silhouette, model, axis_points, scene, options))
+              hold_axis_to_points(m, T_antenna_board, *cov_silhouette, model, axis_points, scene, fits_points, options))
         cov_silhouette = held;
   }
   m.R_board_antenna = T_antenna_board.rotation().transpose();
   m.p_board_antenna = T_antenna_board.inverse().translation();
 
   // The points' agreement with the final pose.
-  const double reach = gopts.fine.max_correspondence_distance_m;
-  double ss = 0.0;
-  std::size_t near = 0;
-  for (const auto& p : m.region.cloud_board.points) {
-    std::size_t index = 0;
-    double d2 = 0.0;
-    if (model_prepared.tree.nearest(T_antenna_board * p, index, d2) && d2 <= reach * reach) ss += d2, ++near;
-  }
-  m.fitness = m.region.cloud_board.empty() ? 0.0 : static_cast<double>(near) / m.region.cloud_board.size();
-  m.fit_rmse_m = near ? std::sqrt(ss / near) : std::numeric_limits<double>::infinity();
+  const PointsFit fit = points_fit(m.region.cloud_board, model_prepared.tree, T_antenna_board, reach);
+  m.fitness = fit.fitness;
+  m.fit_rmse_m = fit.rmse_m;
   // With the outline deciding the pose the points only place it, and clutter (mast, arms) may
   // outnumber them; without it they must carry the fit.
   const double fail_fitness = cov_silhouette ? options.fail_fitness_with_outline : options.fail_fitness;

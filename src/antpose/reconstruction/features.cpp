@@ -54,7 +54,7 @@ ViewFeatures detect_features(const cv::Mat& image, const cv::Mat& mask, const cv
 std::vector<std::pair<int, int>> ratio_matches(const ViewFeatures& a, const ViewFeatures& b, double ratio) {
   std::vector<std::pair<int, int>> out;
   if (a.descriptors.rows < 2 || b.descriptors.rows < 2) return out;
-  cv::FlannBasedMatcher matcher;
+  cv::BFMatcher matcher(cv::NORM_L2);
   std::vector<std::vector<cv::DMatch>> knn;
   matcher.knnMatch(a.descriptors, b.descriptors, knn, 2);
   for (const auto& m : knn)

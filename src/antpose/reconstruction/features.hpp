@@ -38,7 +38,8 @@ ViewFeatures detect_features(const cv::Mat& image, const cv::Mat& mask, const cv
                              int max_side, const camera::CameraIntrinsics& intrinsics, double max_upscale = 1.0,
                              double contrast_threshold = 0.04);
 
-/// Index pairs (feature in a, feature in b) passing Lowe's ratio test (FLANN k-d trees).
+/// Index pairs (feature in a, feature in b) passing Lowe's ratio test, by exhaustive search: FLANN's
+/// randomised k-d trees drew from a shared generator in parallel and gave other matches each run.
 std::vector<std::pair<int, int>> ratio_matches(const ViewFeatures& a, const ViewFeatures& b, double ratio);
 
 /// The candidates within `max_epipolar_px` of the epipolar lines of p_b = R_b_a p_a + t_b_a, a
