@@ -562,10 +562,13 @@ void register_model(AntennaMeasurement& m, const model::AntennaModel& model, con
       if (held_axis->dot(scene.up_board) < 0.0) held_axis = -*held_axis;
       auto held = silhouette_search(model, T_antenna_board.inverse(), scene, options, held_axis);
       held.tried += pick.tried;
-      if (held.best)
+      if (held.best) {
         pick = std::move(held);
-      else
+      } else {
         pick.tried = held.tried;
+        // On a second pass the free search has not run: the held search's is the closest start.
+        if (pick.closest_failure.empty()) pick.closest_failure = std::move(held.closest_failure);
+      }
     }
     if (!pick.best)
       // On the acceptance captures the points alone were tens of degrees off in yaw whenever the
