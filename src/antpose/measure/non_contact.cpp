@@ -314,8 +314,25 @@ void decide_front_by_mount(AntennaMeasurement& m, SilhouettePick& pick, const mo
     if (!mount_turns) turn_round();
     pick.rivals.push_back(pick.turned->T_board_antenna.linear());
   }
-  m.mount_points = side;
+  // Neither cue decides and the panel turned round fits about as well (a rival): the one that
+  // tilts down is reported, since mounts tilt panels down, and the σ still covers the other. As
+  // registered, 2402 and 2506-3 (ground, 1.5° and 1.9° down) came out turned round, tilting up.
   const bool decided = call.verdict != MountVerdict::kUndecided;
+  const auto turned_is_rival = [&] {
+    const Vec3 boresight = pick.best->T_board_antenna.linear().col(1);
+    return std::any_of(pick.rivals.begin(), pick.rivals.end(), [&](const Mat3& R) {
+      return rad2deg(angle_between(R.col(1), boresight)) > 180.0 - options.rival_min_deg;
+    });
+  };
+  if (!decided && !call.in_doubt && pick.turned && tilt_turned > tilt && turned_is_rival()) {
+    m.warnings.push_back(
+        fmt::format("front and back are undecided (the mount: {} points behind the panel, {} before it): of the "
+                    "two ways round the one with a downtilt of {:+.1f}° is reported, not the one with {:+.1f}°",
+                    side.behind, side.before, rad2deg(tilt_turned), rad2deg(tilt)));
+    turn_round();
+    pick.rivals.push_back(pick.turned->T_board_antenna.linear());
+  }
+  m.mount_points = side;
   const Vec3 boresight = pick.best->T_board_antenna.linear().col(1);
   std::erase_if(pick.rivals, [&](const Mat3& R) {
     return (decided && R.col(1).dot(boresight) < 0.0) ||
