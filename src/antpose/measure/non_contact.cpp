@@ -571,13 +571,12 @@ void register_model(AntennaMeasurement& m, const model::AntennaModel& model, con
     // the search is repeated with the long axis held to the points' and the mast known
     // (with_mast), its yaw then bounded by the outline's profile.
     std::optional<Scene> with_the_mast;
-    if (!pick.best) with_the_mast.emplace(with_mast(m, site, T_antenna_board, model, options));
-    const Scene& scene = with_the_mast ? *with_the_mast : site;
     std::optional<Vec3> held_axis;
     if (!pick.best && options.held_axis_search) {
+      with_the_mast.emplace(with_mast(m, site, T_antenna_board, model, options));
       held_axis = points_long_axis(cloud, model_prepared, T_antenna_board, options);
-      if (held_axis->dot(scene.up_board) < 0.0) held_axis = -*held_axis;
-      auto held = silhouette_search(model, T_antenna_board.inverse(), scene, options, held_axis);
+      if (held_axis->dot(site.up_board) < 0.0) held_axis = -*held_axis;
+      auto held = silhouette_search(model, T_antenna_board.inverse(), *with_the_mast, options, held_axis);
       held.tried += pick.tried;
       if (held.best) {
         pick = std::move(held);
@@ -587,6 +586,7 @@ void register_model(AntennaMeasurement& m, const model::AntennaModel& model, con
         if (pick.closest_failure.empty()) pick.closest_failure = std::move(held.closest_failure);
       }
     }
+    const Scene& scene = with_the_mast ? *with_the_mast : site;
     if (!pick.best)
       // On the acceptance captures the points alone were tens of degrees off in yaw whenever the
       // outline failed: no number is better than that one.
