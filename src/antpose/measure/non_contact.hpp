@@ -86,6 +86,11 @@ struct NonContactOptions {
   /// the right poses scored 0.013–0.351, the confidently wrong ones (606-3 65°, 610-1 28°,
   /// 1008-1 130° off) 0.466–0.562.
   double silhouette_max_score = 0.4;
+  /// A winner scoring above this fits the outline poorly enough that the held-axis search (the
+  /// points' long axis, the mast known) is run too, and wins where it scores lower. The right
+  /// poses of 27 development sites scored at most 0.24 but for three antennas partly hidden by
+  /// their mast (1612-3, 1712-1: 0.34–0.36), and 2112-3's, 79° off, 0.37.
+  double silhouette_doubtful_score = 0.3;
   /// A start whose descent left its basin is descended again from where it ended, up to this many
   /// times, until a descent stays put (non_contact.cpp, silhouette_search). More than once let a
   /// start far from the truth settle in a wrong basin that scored best (606-3, 52° off).
