@@ -221,7 +221,11 @@ RefinedPoses refine_camera_poses(const std::vector<PosedView>& views, const came
       if (scene_ids) scene_ids->push_back(id);
     }
     ceres::Solver::Options so;
-    so.linear_solver_type = ceres::SPARSE_SCHUR;
+    // The reduced camera system is small (6 per photo) and dense: Eigen's dense Cholesky solves
+    // it, single-threaded and the same to the last bit on every run (SuiteSparse brings its own
+    // OpenMP and BLAS threads).
+    so.linear_solver_type = ceres::DENSE_SCHUR;
+    so.dense_linear_algebra_library_type = ceres::EIGEN;
     so.max_num_iterations = options.max_iterations;
     // One thread: with two, runs of `antpose measure` on the same photos differed, and near-ties
     // downstream turned on it (1805-3's start among panel hypotheses scoring alike: answered in
@@ -312,6 +316,7 @@ RefinedPoses refine_camera_poses(const std::vector<PosedView>& views, const came
     const double variance = 2.0 * cost / dof;
     ceres::Covariance::Options co;
     co.algorithm_type = ceres::SPARSE_QR;
+    co.sparse_linear_algebra_library_type = ceres::EIGEN_SPARSE;  // as the solve: no foreign threads
     co.num_threads = 1;
     ceres::Covariance covariance(co);
     std::vector<std::pair<const double*, const double*>> blocks;
