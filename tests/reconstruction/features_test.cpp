@@ -97,5 +97,48 @@ TEST(ReconstructFeatures, EpipolarFilterKeepsTrueMatches) {
   EXPECT_GT(kept.size(), 70u);
 }
 
+// Points along the camera's axis (identity pose: depth = z), spread across 0.3 m sideways.
+std::vector<Vec3> at_depths(std::size_t count, double z_from, double z_to, std::mt19937& rng) {
+  std::uniform_real_distribution<double> z(z_from, z_to), side(-0.15, 0.15);
+  std::vector<Vec3> out;
+  for (std::size_t i = 0; i < count; ++i) out.emplace_back(side(rng), side(rng), z(rng));
+  return out;
+}
+
+TEST(DepthRange, ThePanelBeforeATexturedWallNotTheWall) {
+  // 2803-2: ~30 features on a rooftop panel 4.2 m away, 295 on a wall behind it.
+  std::mt19937 rng(3);
+  auto points = at_depths(30, 4.2, 4.5, rng);
+  const auto wall = at_depths(300, 17.5, 18.5, rng);  // more than five times the panel's
+  points.insert(points.end(), wall.begin(), wall.end());
+  const auto range = nearest_depth_cluster(points, Mat3::Identity(), Vec3::Zero(), 3);
+  ASSERT_TRUE(range);
+  EXPECT_EQ(range->support, 30u);
+  EXPECT_LT(range->near, 4.2);
+  EXPECT_GT(range->far, 4.5);
+  EXPECT_LT(range->far, 5.0);
+  EXPECT_NEAR(range->centre_board.z(), 4.35, 0.05);
+}
+
+TEST(DepthRange, AFewStraysBeforeThePanelAreNoObject) {
+  // Three features on the board's edge 2 m nearer than a panel of 60: the panel's range.
+  std::mt19937 rng(4);
+  auto points = at_depths(3, 2.0, 2.1, rng);
+  const auto panel = at_depths(60, 4.0, 4.4, rng);
+  points.insert(points.end(), panel.begin(), panel.end());
+  const auto range = nearest_depth_cluster(points, Mat3::Identity(), Vec3::Zero(), 3);
+  ASSERT_TRUE(range);
+  EXPECT_EQ(range->support, 60u);
+  EXPECT_GT(range->near, 3.0);
+  // Below kObjectSupport a fifth of the fullest window still rules: 10 strays before 200 points.
+  auto crowd = at_depths(10, 2.0, 2.1, rng);
+  const auto big = at_depths(200, 4.0, 4.4, rng);
+  crowd.insert(crowd.end(), big.begin(), big.end());
+  EXPECT_EQ(nearest_depth_cluster(crowd, Mat3::Identity(), Vec3::Zero(), 3)->support, 200u);
+  // No points: no range; too few anywhere: the support says so.
+  EXPECT_FALSE(nearest_depth_cluster({}, Mat3::Identity(), Vec3::Zero(), 3));
+  EXPECT_EQ(nearest_depth_cluster(at_depths(2, 4.0, 4.1, rng), Mat3::Identity(), Vec3::Zero(), 3)->support, 2u);
+}
+
 }  // namespace
 }  // namespace antpose::reconstruction::detail

@@ -83,4 +83,21 @@ std::optional<Vec3> triangulate_track(std::vector<Observation>& track, const std
 /// set to 0 and everything else 255.
 cv::Mat mask_outside_hull(const cv::Size& size, const std::vector<Vec2>& points, double grow_px);
 
+/// A region's depth range along a camera's axis (depths z = (R p + t).z, m).
+struct DepthRange {
+  double near = 0, far = 0;
+  std::size_t support = 0;           // points in the window
+  Vec3 centre_board = Vec3::Zero();  // their mean
+};
+
+/// Any window of this many points is an object, however full the fullest window is.
+inline constexpr std::size_t kObjectSupport = 20;
+
+/// The nearest window of depths (max(1.5 m, 10 % of the depth) wide) holding at least
+/// `min_support` points and a fifth of the fullest window's or kObjectSupport, shifted within
+/// its width to the position that holds most points, widened by 0.15 m + 3 %. When no window
+/// qualifies, only `support` is set: the fullest window's count. nullopt for no points.
+std::optional<DepthRange> nearest_depth_cluster(const std::vector<Vec3>& points_board, const Mat3& R, const Vec3& t,
+                                                std::size_t min_support);
+
 }  // namespace antpose::reconstruction::detail

@@ -40,6 +40,58 @@
 #include "antpose/registration/local_geometry.hpp"
 
 namespace antpose::reconstruction {
+namespace detail {
+
+// Nearest, not densest: whatever else a rectangle drawn around an antenna holds (sky, ground,
+// buildings, trees) lies behind the antenna, and may carry more texture than its radome. The
+// fifth rules out a few stray triangulations nearer than the object (the board's edge); but a
+// textured wall behind a panel may hold more than five times its features (2803-2: ~30 on the
+// panel 4.2 m away, 295 on a wall at 12–18 m), and kObjectSupport in one window are an object.
+std::optional<DepthRange> nearest_depth_cluster(const std::vector<Vec3>& points_board, const Mat3& R, const Vec3& t,
+                                                std::size_t min_support) {
+  if (points_board.empty()) return std::nullopt;
+  std::vector<std::pair<double, std::size_t>> z;
+  for (std::size_t i = 0; i < points_board.size(); ++i) z.emplace_back((R * points_board[i] + t).z(), i);
+  std::sort(z.begin(), z.end());
+  // A panel is at most ~1.4 m deep along any ray; allow for triangulation noise at range.
+  auto width = [&](std::size_t lo) { return std::max(1.5, 0.1 * z[lo].first); };
+  auto end_of = [&](std::size_t lo) {
+    std::size_t hi = lo;
+    while (hi < z.size() && z[hi].first <= z[lo].first + width(lo)) ++hi;
+    return hi;
+  };
+  // The nearest cluster holding a fifth of the largest's support: a few stray triangulations
+  // nearer than the object (the board's edge, the tripod) are no cluster.
+  std::size_t largest = 0;
+  for (std::size_t lo = 0; lo < z.size(); ++lo) largest = std::max(largest, end_of(lo) - lo);
+  const std::size_t needed = std::max(min_support, std::min(largest / 5, kObjectSupport));
+  std::size_t first = z.size();
+  for (std::size_t lo = 0; lo < z.size(); ++lo)
+    if (end_of(lo) - lo >= needed) {
+      first = lo;
+      break;
+    }
+  DepthRange r;
+  if (first == z.size()) {
+    r.support = 0;
+    for (std::size_t lo = 0; lo < z.size(); ++lo) r.support = std::max(r.support, end_of(lo) - lo);
+    return r;
+  }
+  std::size_t best_lo = first, best_hi = end_of(first);
+  for (std::size_t lo = first; lo < z.size() && z[lo].first <= z[first].first + width(first); ++lo)
+    if (end_of(lo) - lo > best_hi - best_lo) best_lo = lo, best_hi = end_of(lo);
+  r.support = best_hi - best_lo;
+  const double zlo = z[best_lo].first, zhi = z[best_hi - 1].first;
+  const double margin = 0.15 + 0.03 * zhi;
+  r.near = std::max(0.1, zlo - margin);
+  r.far = zhi + margin;
+  for (std::size_t k = best_lo; k < best_hi; ++k) r.centre_board += points_board[z[k].second];
+  r.centre_board /= double(r.support);
+  return r;
+}
+
+}  // namespace detail
+
 namespace {
 
 Vec3 centre_of(const Mat3& R, const Vec3& t) { return -R.transpose() * t; }
@@ -66,59 +118,7 @@ std::vector<Vec3> frustum_samples(const Roi& roi, const Mat3& R, const Vec3& t, 
   return out;
 }
 
-struct DepthRange {
-  double near = 0, far = 0;
-  std::size_t support = 0;
-  Vec3 centre_board = Vec3::Zero();
-};
-
-/// The nearest window of depths holding at least `min_support` points and a fifth of the
-/// fullest window's, shifted within its width to the position that holds most points (the
-/// cluster's centre), widened by a margin.
-/// Nearest, not densest: whatever else a rectangle drawn around an antenna holds (sky, ground,
-/// buildings, trees) lies behind the antenna, and may carry more texture than its radome.
-std::optional<DepthRange> nearest_depth_cluster(const std::vector<Vec3>& points_board, const Mat3& R, const Vec3& t,
-                                                std::size_t min_support) {
-  if (points_board.empty()) return std::nullopt;
-  std::vector<std::pair<double, std::size_t>> z;
-  for (std::size_t i = 0; i < points_board.size(); ++i) z.emplace_back((R * points_board[i] + t).z(), i);
-  std::sort(z.begin(), z.end());
-  // A panel is at most ~1.4 m deep along any ray; allow for triangulation noise at range.
-  auto width = [&](std::size_t lo) { return std::max(1.5, 0.1 * z[lo].first); };
-  auto end_of = [&](std::size_t lo) {
-    std::size_t hi = lo;
-    while (hi < z.size() && z[hi].first <= z[lo].first + width(lo)) ++hi;
-    return hi;
-  };
-  // The nearest cluster holding a fifth of the largest's support: a few stray triangulations
-  // nearer than the object (the board's edge, the tripod) are no cluster.
-  std::size_t largest = 0;
-  for (std::size_t lo = 0; lo < z.size(); ++lo) largest = std::max(largest, end_of(lo) - lo);
-  const std::size_t needed = std::max(min_support, largest / 5);
-  std::size_t first = z.size();
-  for (std::size_t lo = 0; lo < z.size(); ++lo)
-    if (end_of(lo) - lo >= needed) {
-      first = lo;
-      break;
-    }
-  DepthRange r;
-  if (first == z.size()) {
-    r.support = 0;
-    for (std::size_t lo = 0; lo < z.size(); ++lo) r.support = std::max(r.support, end_of(lo) - lo);
-    return r;
-  }
-  std::size_t best_lo = first, best_hi = end_of(first);
-  for (std::size_t lo = first; lo < z.size() && z[lo].first <= z[first].first + width(first); ++lo)
-    if (end_of(lo) - lo > best_hi - best_lo) best_lo = lo, best_hi = end_of(lo);
-  r.support = best_hi - best_lo;
-  const double zlo = z[best_lo].first, zhi = z[best_hi - 1].first;
-  const double margin = 0.15 + 0.03 * zhi;
-  r.near = std::max(0.1, zlo - margin);
-  r.far = zhi + margin;
-  for (std::size_t k = best_lo; k < best_hi; ++k) r.centre_board += points_board[z[k].second];
-  r.centre_board /= double(r.support);
-  return r;
-}
+using detail::DepthRange;
 
 struct PairCloud {
   int a = 0, b = 0;
@@ -499,7 +499,7 @@ RegionReconstruction reconstruct_region(const std::vector<PosedView>& views, con
   // Few: a plain radome gives only a handful of features (its corners, brackets); the nearest
   // cluster rule keeps them from being outvoted by the background.
   constexpr std::size_t kMinSparse = 3;
-  const auto range = nearest_depth_cluster(sparse, Rr, tr, kMinSparse);
+  const auto range = detail::nearest_depth_cluster(sparse, Rr, tr, kMinSparse);
   if (!range || range->support < kMinSparse)
     throw MeasurementError(fmt::format(
         "no texture or object in the region of {}: only {} feature points could be triangulated there (at least {} "
