@@ -316,7 +316,7 @@ RefinedPoses refine_camera_poses(const std::vector<PosedView>& views, const came
     const double variance = 2.0 * cost / dof;
     ceres::Covariance::Options co;
     co.algorithm_type = ceres::SPARSE_QR;
-    co.sparse_linear_algebra_library_type = ceres::EIGEN_SPARSE;  // as the solve: no foreign threads
+    // SuiteSparse's QR: Eigen's took 18 s for the 3000 tracks of a ground site (0.1 s here).
     co.num_threads = 1;
     ceres::Covariance covariance(co);
     std::vector<std::pair<const double*, const double*>> blocks;
