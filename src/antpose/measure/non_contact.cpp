@@ -441,13 +441,18 @@ YawProfile profile_yaw(const model::AntennaModel& model, const Iso3& T_board_ant
 // panel however it is turned about its axis (the points' yaw may be far off): in the photos where
 // it stands in front of the antenna it hides what lies behind it, elsewhere its edges are known
 // not to be the antenna's. The scene's photos for the outline carry it.
-Scene with_mast(AntennaMeasurement& m, const Scene& scene, const Iso3& T_antenna_board,
-                const model::AntennaModel& model, const NonContactOptions& options) {
-  if (!options.mast) return scene;
+struct MastScene {
+  Scene scene;
+  std::optional<reconstruction::Mast> mast;  // the mast found, if any
+};
+
+MastScene with_mast(const PointCloud& cloud_board, const Scene& scene, const Iso3& T_antenna_board,
+                    const model::AntennaModel& model, const NonContactOptions& options) {
+  if (!options.mast) return {scene, std::nullopt};
   const double across = 0.5 * model.size_m.head<2>().norm() + options.mast_clearance_m;
   const double along = 0.5 * model.size_m.z() + options.mast_clearance_m;
   PointCloud beyond;
-  for (const Vec3& p : m.region.cloud_board.points) {
+  for (const Vec3& p : cloud_board.points) {
     const Vec3 a = T_antenna_board * p;
     if (a.head<2>().norm() > across || std::abs(a.z()) > along) beyond.points.push_back(p);
   }
@@ -455,7 +460,7 @@ Scene with_mast(AntennaMeasurement& m, const Scene& scene, const Iso3& T_antenna
   const double bottom = scene.up_board.normalized().dot(T_antenna_board.inverse().translation()) - along;
   auto mast = reconstruction::fit_mast(beyond, scene.up_board, scene.views, scene.intrinsics,
                                        bottom - options.mast_outline_below_m, bottom, options.mast_options);
-  if (!mast) return scene;
+  if (!mast) return {scene, std::nullopt};
   Scene out = scene;
   const Vec3 centre = T_antenna_board.inverse().translation();
   for (std::size_t i = 0; i < out.outline_views.size(); ++i) {
@@ -470,8 +475,7 @@ Scene with_mast(AntennaMeasurement& m, const Scene& scene, const Iso3& T_antenna
       v.background_edges.push_back(std::move(lines[1]));
     }
   }
-  m.mast = mast;
-  return out;
+  return {std::move(out), std::move(mast)};
 }
 
 // The other antennas already registered, as known objects in the photos of antenna k: each one's
@@ -576,13 +580,13 @@ void register_model(AntennaMeasurement& m, const model::AntennaModel& model, con
     const std::optional<double> doubtful_score = pick.best && pick.best->score > options.silhouette_doubtful_score
                                                      ? std::optional(pick.best->score)
                                                      : std::nullopt;
-    std::optional<Scene> with_the_mast;
+    std::optional<MastScene> with_the_mast;
     std::optional<Vec3> held_axis;
     if ((!pick.best || doubtful_score) && options.held_axis_search) {
-      with_the_mast.emplace(with_mast(m, site, T_antenna_board, model, options));
+      with_the_mast.emplace(with_mast(m.region.cloud_board, site, T_antenna_board, model, options));
       held_axis = points_long_axis(cloud, model_prepared, T_antenna_board, options);
       if (held_axis->dot(site.up_board) < 0.0) held_axis = -*held_axis;
-      auto held = silhouette_search(model, T_antenna_board.inverse(), *with_the_mast, options, held_axis);
+      auto held = silhouette_search(model, T_antenna_board.inverse(), with_the_mast->scene, options, held_axis);
       held.tried += pick.tried;
       if (held.best && (!doubtful_score || held.best->score < *doubtful_score)) {
         pick = std::move(held);
@@ -590,14 +594,14 @@ void register_model(AntennaMeasurement& m, const model::AntennaModel& model, con
         // The free search's winner stands, and nothing of the held search's is used.
         with_the_mast.reset();
         held_axis.reset();
-        m.mast.reset();
       } else {
         pick.tried = held.tried;
         // On a second pass the free search has not run: the held search's is the closest start.
         if (pick.closest_failure.empty()) pick.closest_failure = std::move(held.closest_failure);
       }
     }
-    const Scene& scene = with_the_mast ? *with_the_mast : site;
+    if (with_the_mast) m.mast = with_the_mast->mast;
+    const Scene& scene = with_the_mast ? with_the_mast->scene : site;
     if (!pick.best)
       // On the acceptance captures the points alone were tens of degrees off in yaw whenever the
       // outline failed: no number is better than that one.

@@ -95,7 +95,8 @@ struct NonContactOptions {
   /// times, until a descent stays put (non_contact.cpp, silhouette_search). Twice once let a start
   /// far from the truth settle in a wrong basin that scored best (606-3, 52° off, before the mast
   /// was known to the held-axis search); with one, 2606-3 (a 2 m panel from the ground) was
-  /// refused, its one start reaching the right basin stopped short of it. With two, on 31
+  /// refused, its one start to reach the right basin doing so on a second descent that moved 23°
+  /// (so counted as leaving its basin); a third stays put there. With two, on 31
   /// development sites 2606-3 is answered (−3.9° on a disturbed site, σ 4.9°) and 606-3, 1706-1
   /// and 2106-1 fit with the axis free (their downtilt errors 0.01–0.05°), nothing else moved.
   int silhouette_redescents = 2;

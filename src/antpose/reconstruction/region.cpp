@@ -60,8 +60,6 @@ std::optional<DepthRange> nearest_depth_cluster(const std::vector<Vec3>& points_
     while (hi < z.size() && z[hi].first <= z[lo].first + width(lo)) ++hi;
     return hi;
   };
-  // The nearest cluster holding a fifth of the largest's support: a few stray triangulations
-  // nearer than the object (the board's edge, the tripod) are no cluster.
   std::size_t largest = 0;
   for (std::size_t lo = 0; lo < z.size(); ++lo) largest = std::max(largest, end_of(lo) - lo);
   const std::size_t needed = std::max(min_support, std::min(largest / 5, kObjectSupport));
