@@ -539,131 +539,186 @@ PointsFit points_fit(const PointCloud& cloud, const registration::KdTree& model,
 }
 
 // Which outline searches run: all of them on the first pass; on a second pass, with more objects
-// known in the photos, only the held-axis search (see its use below for why).
+// known in the photos, only the held-axis search (see search_outline for why).
 enum class OutlinePass { kFirst, kHeldAxisOnly };
 
-void register_model(AntennaMeasurement& m, const model::AntennaModel& model, const Scene& site,
-                    const NonContactOptions& options, OutlinePass pass = OutlinePass::kFirst) {
-  const PointCloud model_cloud = model::sample_surface(model.mesh_antenna, options.model_spacing_m, options.seed);
-  const auto model_prepared = registration::prepare(model_cloud, options.registration.fine);
+// The model registered to the region's points alone (registration/global_start.hpp), with the
+// model's samples and both prepared clouds, which the outline stage and a second pass reuse.
+struct PointsRegistration {
+  PointCloud model_cloud;                    // the model's surface samples, antenna frame
+  registration::PreparedCloud model, cloud;  // the samples; the region's points (board frame)
+  registration::GlobalStartResult start;     // its fit: T_antenna_board
+  double reach_m = 0.0;                      // the fine ICP's correspondence distance
+};
+
+PointsRegistration register_points(const PointCloud& cloud_board, const model::AntennaModel& model, const Scene& site,
+                                   const NonContactOptions& options) {
+  PointCloud model_cloud = model::sample_surface(model.mesh_antenna, options.model_spacing_m, options.seed);
+  auto model_prepared = registration::prepare(model_cloud, options.registration.fine);
   auto gopts = options.registration;
   gopts.viewpoints_scene = site.viewpoints;
-  const auto cloud = registration::prepare(m.region.cloud_board, gopts.fine);
-  const auto g = registration::global_align(cloud, model_prepared, site.up_board, gopts);
+  auto cloud = registration::prepare(cloud_board, gopts.fine);
+  auto start = registration::global_align(cloud, model_prepared, site.up_board, gopts);
+  return {std::move(model_cloud), std::move(model_prepared), std::move(cloud), std::move(start),
+          gopts.fine.max_correspondence_distance_m};
+}
+
+// The outline search's outcome: the winner, and where the held-axis search's was kept, the axis
+// it held; and the scene with the mast it knew wherever the held search ran and the free
+// search's winner does not stand.
+struct OutlineSearch {
+  SilhouettePick pick;
+  std::optional<MastScene> with_the_mast;
+  std::optional<Vec3> held_axis;
+  std::optional<double> doubtful_score;  // the free winner's poor score, when the held search beat it
+};
+
+// Known objects (the mast, the other antennas) change every start's basin: in the free search
+// they let poses 43–90° off win with small σ (1612-3, 2004-2, 1702-1, 610-1 with the mast; 2106-1
+// with the other panels, −55° and the tilt −3.2° with σ 0.24°), so they are known only to the
+// held-axis search, whose yaw the outline's profile then bounds. Where neither search converged,
+// `pick` has no winner.
+OutlineSearch search_outline(const PointCloud& cloud_board, const model::AntennaModel& model,
+                             const PointsRegistration& points, const Scene& site, const NonContactOptions& options,
+                             OutlinePass pass) {
+  const Iso3& T_antenna_board = points.start.fit.T_target_source;
+  OutlineSearch s;
+  auto& pick = s.pick;
+  if (pass == OutlinePass::kFirst) pick = silhouette_search(model, T_antenna_board.inverse(), site, options);
+  // A narrow panel seen from below can trade yaw for tilt in its outline, and the mast's edges
+  // beside it lure the descents away or the mast hides part of it: where no start converged, the
+  // search is repeated with the long axis held to the points' and the mast known (with_mast). So
+  // it is where the free search's winner fits the outline poorly
+  // (options.silhouette_doubtful_score), and the held search's wins if it fits better: 2112-3, a
+  // thesis panel a third hidden by its mast, won the free search 79° off at 0.37 (its downtilt
+  // and roll swapped, σ 0.2°); held, 0.16.
+  const std::optional<double> doubtful_score = pick.best && pick.best->score > options.silhouette_doubtful_score
+                                                   ? std::optional(pick.best->score)
+                                                   : std::nullopt;
+  if ((!pick.best || doubtful_score) && options.held_axis_search) {
+    auto with_the_mast = with_mast(cloud_board, site, T_antenna_board, model, options);
+    Vec3 axis = points_long_axis(points.cloud, points.model, T_antenna_board, options);
+    if (axis.dot(site.up_board) < 0.0) axis = -axis;
+    auto held = silhouette_search(model, T_antenna_board.inverse(), with_the_mast.scene, options, axis);
+    held.tried += pick.tried;
+    if (held.best && (!doubtful_score || held.best->score < *doubtful_score)) {
+      pick = std::move(held);
+      s.held_axis = axis;
+      s.doubtful_score = doubtful_score;
+    } else if (doubtful_score) {
+      return s;  // the free search's winner stands, and nothing of the held search's is used
+    } else {
+      pick.tried = held.tried;
+      // On a second pass the free search has not run: the held search's is the closest start.
+      if (pick.closest_failure.empty()) pick.closest_failure = std::move(held.closest_failure);
+    }
+    s.with_the_mast.emplace(std::move(with_the_mast));
+  }
+  return s;
+}
+
+// The outline stage's result: the pose, its rotation covariance and rivals.
+struct OutlineFit {
+  Iso3 T_antenna_board = Iso3::Identity();
+  Mat3 cov_board = Mat3::Zero();  // rotation, rad², board frame
+  std::vector<Mat3> rivals_board;
+};
+
+// The outline decides the yaw where the points cannot (docs/non-contact.md): the search, front
+// and back by the mount, then the yaw's range about a held axis (profile_yaw) or the outline's
+// axis against the points' (hold_axis_to_points). OutlineNotFound where no search converged.
+// Writes its warnings, the mount's counts, the
+// mast and the method into `m`.
+OutlineFit fit_outline(AntennaMeasurement& m, const model::AntennaModel& model, const PointsRegistration& points,
+                       const Scene& site, const NonContactOptions& options, OutlinePass pass) {
+  auto [pick, with_the_mast, held_axis, doubtful_score] =
+      search_outline(m.region.cloud_board, model, points, site, options, pass);
+  if (with_the_mast) m.mast = with_the_mast->mast;
+  if (!pick.best)
+    // On the acceptance captures the points alone were tens of degrees off in yaw whenever the
+    // outline failed: no number is better than that one.
+    throw OutlineNotFound(fmt::format(
+        "the model's outline matched the photos from none of {} starts, and the points alone do not fix the "
+        "panel's yaw: is the whole antenna inside the photos, free of other panels in front of it, and is the "
+        "model this antenna's? (closest start: {})",
+        pick.tried, fmt::join(pick.closest_failure, "; ")));
+  const Scene& scene = with_the_mast ? with_the_mast->scene : site;
+  // With the axis held, the points' axis is the held one: ICP from the outline's pose may find
+  // another (below).
+  const Vec3 axis_points =
+      held_axis ? *held_axis
+                : points_long_axis(points.cloud, points.model, pick.best->T_board_antenna.inverse(), options);
+  decide_front_by_mount(m, pick, model, points.model, axis_points, points.reach_m, scene.up_board, options);
+  OutlineFit fit{pick.best->T_board_antenna.inverse(), pick.best->covariance.topLeftCorner<3, 3>(), pick.rivals};
+  if (held_axis) {
+    // The yaw's σ: a uniform spread over the bounded range (half-width h: h/√3).
+    const auto profile = profile_yaw(model, pick.best->T_board_antenna, scene, options);
+    fit.T_antenna_board = profile.T_board_antenna.inverse();
+    const Mat3& R = profile.T_board_antenna.linear();
+    // The points' ICP from the result's pose may settle on another axis (clutter in the region
+    // pulls it differently from another start: 1604-2, 3.5° off where the held one was 0.6°): the
+    // held axis stays, and its σ covers both, as in hold_axis_to_points.
+    const Vec3 axis_again = points_long_axis(points.cloud, points.model, fit.T_antenna_board, options);
+    const double disagreement = angle_between(axis_again, R.col(2));
+    const double sa = deg2rad(options.held_axis_sigma_deg);
+    const double sy = (profile.high_rad - profile.low_rad) / 2 / std::sqrt(3.0);
+    fit.cov_board +=
+        across_long_axis(R, sa * sa + std::pow(disagreement / 2, 2)) + sy * sy * R.col(2) * R.col(2).transpose();
+    if (rad2deg(disagreement) > options.axis_gate_deg)
+      m.warnings.push_back(fmt::format(
+          "the points' long axis depends on where their registration starts: {:.1f}° apart from the outline's "
+          "pose and from the points' own; the downtilt and roll σ cover both",
+          rad2deg(disagreement)));
+    m.warnings.push_back(fmt::format(
+        "the outline fitted {} with its long axis free; it fitted {}with the points' axis held, so the downtilt and "
+        "roll are the points' and the outline fixes the yaw about their axis, within {}{:+.0f}° to {:+.0f}° of the "
+        "result (a narrow panel's outline barely changes with yaw when seen face-on from below: photograph it over "
+        "a wider arc or from nearer)",
+        doubtful_score ? fmt::format("poorly (score {:.2f})", *doubtful_score) : std::string("from no start"),
+        doubtful_score ? fmt::format("better ({:.2f}) ", pick.best->score) : std::string(),
+        profile.open ? "more than " : "", rad2deg(profile.low_rad), rad2deg(profile.high_rad)));
+  }
+  m.silhouette_rms_px = pick.best->rms_px;
+  m.method = fmt::format("model {}, points + outline in {} photos", model.name, pick.best->views_used);
+  for (const auto& w : pick.best->warnings) m.warnings.push_back("outline: " + w);
+  if (pick.flipped_by_outline)
+    m.warnings.push_back(
+        "the outline turned the points' front/back decision (the brackets' outline fits "
+        "clearly better the other way round)");
+  if (!held_axis) {
+    // The outline has fitted something else where its pose leaves far fewer points near the
+    // model than the points' own pose does (options.outline_points_fit_ratio).
+    const auto fits_points = [&](const Iso3& T) {
+      return points_fit(m.region.cloud_board, points.model.tree, T, points.reach_m).fitness >=
+             options.outline_points_fit_ratio * points.start.fit.fitness;
+    };
+    if (const auto held =
+            hold_axis_to_points(m, fit.T_antenna_board, fit.cov_board, model, axis_points, scene, fits_points, options))
+      fit.cov_board = *held;
+  }
+  return fit;
+}
+
+// The model registered to the region: by its points, then its outline (fit_outline); the
+// pose's covariance from the outline, or else by resampling the points; the fit's checks.
+void register_model(AntennaMeasurement& m, const model::AntennaModel& model, const PointsRegistration& points,
+                    const Scene& site, const NonContactOptions& options, OutlinePass pass = OutlinePass::kFirst) {
+  const auto& g = points.start;
   Iso3 T_antenna_board = g.fit.T_target_source;
-  const double reach = gopts.fine.max_correspondence_distance_m;
-  // The outline has fitted something else where its pose leaves far fewer points near the model
-  // than the points' own pose does (options.outline_points_fit_ratio).
-  const auto fits_points = [&](const Iso3& T) {
-    return points_fit(m.region.cloud_board, model_prepared.tree, T, reach).fitness >=
-           options.outline_points_fit_ratio * g.fit.fitness;
-  };
   m.method = "model " + model.name + ", points";
   m.front_back_margin = g.front_back_margin;
-
-  // The outline decides the yaw where the points cannot (docs/non-contact.md).
   std::optional<Mat3> cov_silhouette;
   if (options.silhouette) {
-    // Known objects (the mast, the other antennas) change every start's basin: in the free
-    // search they let poses 43–90° off win with small σ (1612-3, 2004-2, 1702-1, 610-1 with the
-    // mast; 2106-1 with the other panels, −55° and the tilt −3.2° with σ 0.24°), so they are known
-    // only to the held-axis search, whose yaw the outline's profile then bounds.
-    auto pick = pass == OutlinePass::kFirst ? silhouette_search(model, T_antenna_board.inverse(), site, options)
-                                            : SilhouettePick{};
-    // A narrow panel seen from below can trade yaw for tilt in its outline, and the mast's edges
-    // beside it lure the descents away or the mast hides part of it: where no start converged,
-    // the search is repeated with the long axis held to the points' and the mast known
-    // (with_mast), its yaw then bounded by the outline's profile. So it is where the free
-    // search's winner fits the outline poorly (options.silhouette_doubtful_score), and the held
-    // search's wins if it fits better: 2112-3, a thesis panel a third hidden by its mast, won
-    // the free search 79° off at 0.37 (its downtilt and roll swapped, σ 0.2°); held, 0.16.
-    const std::optional<double> doubtful_score = pick.best && pick.best->score > options.silhouette_doubtful_score
-                                                     ? std::optional(pick.best->score)
-                                                     : std::nullopt;
-    std::optional<MastScene> with_the_mast;
-    std::optional<Vec3> held_axis;
-    if ((!pick.best || doubtful_score) && options.held_axis_search) {
-      with_the_mast.emplace(with_mast(m.region.cloud_board, site, T_antenna_board, model, options));
-      held_axis = points_long_axis(cloud, model_prepared, T_antenna_board, options);
-      if (held_axis->dot(site.up_board) < 0.0) held_axis = -*held_axis;
-      auto held = silhouette_search(model, T_antenna_board.inverse(), with_the_mast->scene, options, held_axis);
-      held.tried += pick.tried;
-      if (held.best && (!doubtful_score || held.best->score < *doubtful_score)) {
-        pick = std::move(held);
-      } else if (doubtful_score) {
-        // The free search's winner stands, and nothing of the held search's is used.
-        with_the_mast.reset();
-        held_axis.reset();
-      } else {
-        pick.tried = held.tried;
-        // On a second pass the free search has not run: the held search's is the closest start.
-        if (pick.closest_failure.empty()) pick.closest_failure = std::move(held.closest_failure);
-      }
-    }
-    if (with_the_mast) m.mast = with_the_mast->mast;
-    const Scene& scene = with_the_mast ? with_the_mast->scene : site;
-    if (!pick.best)
-      // On the acceptance captures the points alone were tens of degrees off in yaw whenever the
-      // outline failed: no number is better than that one.
-      throw OutlineNotFound(fmt::format(
-          "the model's outline matched the photos from none of {} starts, and the points alone do not fix the "
-          "panel's yaw: is the whole antenna inside the photos, free of other panels in front of it, and is the "
-          "model this antenna's? (closest start: {})",
-          pick.tried, fmt::join(pick.closest_failure, "; ")));
-    // With the axis held, the points' axis is the held one: ICP from the outline's pose may find
-    // another (below).
-    const Vec3 axis_points =
-        held_axis ? *held_axis : points_long_axis(cloud, model_prepared, pick.best->T_board_antenna.inverse(), options);
-    decide_front_by_mount(m, pick, model, model_prepared, axis_points, gopts.fine.max_correspondence_distance_m,
-                          scene.up_board, options);
-    T_antenna_board = pick.best->T_board_antenna.inverse();
-    cov_silhouette = pick.best->covariance.topLeftCorner<3, 3>();
-    if (held_axis) {
-      // The yaw's σ: a uniform spread over the bounded range (half-width h: h/√3).
-      const auto profile = profile_yaw(model, pick.best->T_board_antenna, scene, options);
-      T_antenna_board = profile.T_board_antenna.inverse();
-      const Mat3& R = profile.T_board_antenna.linear();
-      // The points' ICP from the result's pose may settle on another axis (clutter in the region
-      // pulls it differently from another start: 1604-2, 3.5° off where the held one was 0.6°):
-      // the held axis stays, and its σ covers both, as in hold_axis_to_points.
-      const Vec3 axis_again = points_long_axis(cloud, model_prepared, T_antenna_board, options);
-      const double disagreement = angle_between(axis_again, R.col(2));
-      const double sa = deg2rad(options.held_axis_sigma_deg);
-      const double sy = (profile.high_rad - profile.low_rad) / 2 / std::sqrt(3.0);
-      *cov_silhouette +=
-          across_long_axis(R, sa * sa + std::pow(disagreement / 2, 2)) + sy * sy * R.col(2) * R.col(2).transpose();
-      if (rad2deg(disagreement) > options.axis_gate_deg)
-        m.warnings.push_back(fmt::format(
-            "the points' long axis depends on where their registration starts: {:.1f}° apart from the outline's "
-            "pose and from the points' own; the downtilt and roll σ cover both",
-            rad2deg(disagreement)));
-      m.warnings.push_back(fmt::format(
-          "the outline fitted {} with its long axis free; it fitted {}with the points' axis held, so the downtilt and "
-          "roll are the points' and the outline fixes the yaw about their axis, within {}{:+.0f}° to {:+.0f}° of the "
-          "result (a narrow panel's outline barely changes with yaw when seen face-on from below: photograph it over "
-          "a wider arc or from nearer)",
-          doubtful_score ? fmt::format("poorly (score {:.2f})", *doubtful_score) : std::string("from no start"),
-          doubtful_score ? fmt::format("better ({:.2f}) ", pick.best->score) : std::string(),
-          profile.open ? "more than " : "", rad2deg(profile.low_rad), rad2deg(profile.high_rad)));
-    }
-    m.rivals_board = pick.rivals;
-    m.silhouette_rms_px = pick.best->rms_px;
-    m.method = fmt::format("model {}, points + outline in {} photos", model.name, pick.best->views_used);
-    for (const auto& w : pick.best->warnings) m.warnings.push_back("outline: " + w);
-    if (pick.flipped_by_outline)
-      m.warnings.push_back(
-          "the outline turned the points' front/back decision (the brackets' outline fits "
-          "clearly better the other way round)");
-    if (!held_axis)
-      if (const auto held =
-              hold_axis_to_points(m, T_antenna_board, *cov_silhouette, model, axis_points, scene, fits_points, options))
-        cov_silhouette = held;
+    auto outline = fit_outline(m, model, points, site, options, pass);
+    T_antenna_board = outline.T_antenna_board;
+    cov_silhouette = outline.cov_board;
+    m.rivals_board = std::move(outline.rivals_board);
   }
   m.R_board_antenna = T_antenna_board.rotation().transpose();
   m.p_board_antenna = T_antenna_board.inverse().translation();
 
   // The points' agreement with the final pose.
-  const PointsFit fit = points_fit(m.region.cloud_board, model_prepared.tree, T_antenna_board, reach);
+  const PointsFit fit = points_fit(m.region.cloud_board, points.model.tree, T_antenna_board, points.reach_m);
   m.fitness = fit.fitness;
   m.fit_rmse_m = fit.rmse_m;
   // With the outline deciding the pose the points only place it, and clutter (mast, arms) may
@@ -674,8 +729,8 @@ void register_model(AntennaMeasurement& m, const model::AntennaModel& model, con
         "the region's {} points do not fit the model '{}': {:.0f} % of them lie within {:.0f} mm of it, RMS {:.1f} mm "
         "(at least {:.0f} % and at most {:.0f} mm expected). Is the rectangle on the antenna, and is the model this "
         "antenna's?",
-        m.region.cloud_board.size(), model.name, 100 * m.fitness, 1e3 * reach, 1e3 * m.fit_rmse_m, 100 * fail_fitness,
-        1e3 * options.fail_rmse_m));
+        m.region.cloud_board.size(), model.name, 100 * m.fitness, 1e3 * points.reach_m, 1e3 * m.fit_rmse_m,
+        100 * fail_fitness, 1e3 * options.fail_rmse_m));
   if (m.fit_rmse_m > options.warn_rmse_m)
     m.warnings.push_back(fmt::format("poor registration fit: RMS {:.1f} mm (more than {:.0f} mm)", 1e3 * m.fit_rmse_m,
                                      1e3 * options.warn_rmse_m));
@@ -696,7 +751,7 @@ void register_model(AntennaMeasurement& m, const model::AntennaModel& model, con
       const Mat3 R = h.T_model_scene.rotation().transpose();
       const double angle = rad2deg(angle_between(R.col(1), boresight));
       if (angle > options.rival_min_deg && angle <= 90.0 &&
-          h.score() - g.hypotheses.front().score() < gopts.ambiguity_margin)
+          h.score() - g.hypotheses.front().score() < options.registration.ambiguity_margin)
         m.rivals_board.push_back(R);
     }
     if (g.front_back_ambiguous)
@@ -711,9 +766,9 @@ void register_model(AntennaMeasurement& m, const model::AntennaModel& model, con
   m.cov_board = cov_silhouette
                     ? *cov_silhouette
                     : Mat3(m.R_board_antenna *
-                           bootstrap_covariance(m.region.cloud_board, model_prepared, T_antenna_board, options) *
+                           bootstrap_covariance(m.region.cloud_board, points.model, T_antenna_board, options) *
                            m.R_board_antenna.transpose());
-  m.model_board = transformed(model_cloud, T_antenna_board.inverse());
+  m.model_board = transformed(points.model_cloud, T_antenna_board.inverse());
 }
 
 // Each rival pose widens each angle's σ to half its difference from the result (the spread of a
@@ -875,9 +930,12 @@ NonContactResult measure_non_contact(const Capture& capture, const NonContactSet
     m.attitude = antenna_attitude(result.board, m.R_board_antenna, m.cov_board, result.site);
     widen_for_rivals(m, result.board, result.site);
   };
-  std::vector<std::size_t> retry;  // outline from no start: tried again with the others known
+  // Antennas whose outline fitted from no start, with their points' registration: tried again
+  // with the others known.
+  std::vector<std::pair<std::size_t, PointsRegistration>> retry;
   for (std::size_t k = 0; k < setup.rois.size(); ++k) {
     AntennaMeasurement m;
+    std::optional<PointsRegistration> points;
     m.roi = setup.rois[k];
     const auto name = fmt::format("antenna {} ({})", k + 1, m.roi.image);
     try {
@@ -894,7 +952,8 @@ NonContactResult measure_non_contact(const Capture& capture, const NonContactSet
       for (const auto& w : m.region.warnings) m.warnings.push_back(w);
       report(options, name + ": registration", 0, 1);
       if (const auto* model = setup.model_for(k)) {
-        register_model(m, *model, scene, options);
+        points = register_points(m.region.cloud_board, *model, scene, options);
+        register_model(m, *model, *points, scene, options);
       } else {
         const FaceFit fit = fit_front_face(m.region.cloud_board, scene.viewpoints, scene.up_board, options.model_free);
         m.method = "model-free (front face + long axis)";
@@ -909,14 +968,14 @@ NonContactResult measure_non_contact(const Capture& capture, const NonContactSet
       finish(m);
     } catch (const OutlineNotFound& e) {
       m.error = e.what();
-      retry.push_back(k);
+      retry.emplace_back(k, std::move(*points));
     } catch (const MeasurementError& e) {
       m.error = e.what();
     }
     result.antennas.push_back(std::move(m));
   }
   // Antennas whose outline fitted from no start, again with the others registered known.
-  for (const std::size_t k : retry) {
+  for (const auto& [k, points] : retry) {
     auto& m = result.antennas[k];
     const bool others = std::any_of(result.antennas.begin(), result.antennas.end(),
                                     [&](const AntennaMeasurement& a) { return &a != &m && !a.error; });
@@ -926,7 +985,7 @@ NonContactResult measure_non_contact(const Capture& capture, const NonContactSet
     again.region = m.region;
     again.warnings = m.region.warnings;
     try {
-      register_model(again, *setup.model_for(k), with_other_antennas(scene, result.antennas, setup, k), options,
+      register_model(again, *setup.model_for(k), points, with_other_antennas(scene, result.antennas, setup, k), options,
                      OutlinePass::kHeldAxisOnly);
       again.warnings.push_back(
           "the outline fitted only with the other antennas' registered outlines known (their edges masked)");
