@@ -297,6 +297,29 @@ TEST(Silhouette, ADescentThatLeftItsBasinSaysWhereItEnded) {
   EXPECT_FALSE(near.left_start.has_value());
 }
 
+// A descent still moving when its iterations run out is not converged, but says so
+// (stopped_at_iteration_limit): a search continues it from where it stopped, and there it
+// converges on the truth. A descent stopped for another reason does not say so.
+TEST(Silhouette, ADescentStoppedByTheIterationLimitCanBeContinued) {
+  const auto& s = scene();
+  SilhouetteOptions options;
+  options.max_iterations_per_level = 2;
+  const Iso3 start = perturbed(s.T_board_antenna, 5.0, 2.0, Vec3(0.03, -0.03, 0.025));
+  const auto r = refine_by_silhouette(s.mesh_antenna, start, s.views, s.intrinsics, options);
+  EXPECT_FALSE(r.converged);
+  EXPECT_TRUE(r.stopped_at_iteration_limit);
+  const auto again = refine_by_silhouette(s.mesh_antenna, r.T_board_antenna, s.views, s.intrinsics, {});
+  EXPECT_TRUE(again.converged);
+  EXPECT_FALSE(again.stopped_at_iteration_limit);
+  EXPECT_LT(axis_errors_deg(again.T_board_antenna.linear(), s.T_board_antenna.linear()).norm(), 0.3);
+
+  SilhouetteOptions strict = options;
+  strict.max_rms_px = 0.01;  // fails the RMS check as well
+  const auto failed = refine_by_silhouette(s.mesh_antenna, start, s.views, s.intrinsics, strict);
+  EXPECT_FALSE(failed.converged);
+  EXPECT_FALSE(failed.stopped_at_iteration_limit);
+}
+
 // Steps that swing back and forth below swing_motion_px have arrived (see silhouette.cpp): the
 // rule ends descents sooner and lands where the strict 0.01 px criterion does.
 TEST(Silhouette, ASwingingDescentHasArrived) {

@@ -173,6 +173,7 @@ struct SilhouettePick {
   std::optional<registration::SilhouetteResult> best;
   std::vector<Mat3> rivals;         // R_board_antenna of each rival
   bool flipped_by_outline = false;  // the outline turned the points' front/back decision
+  bool rival_yaw = false;           // a converged start at another yaw is a rival
   /// The winner turned by 180° about its own long axis (front and back swapped: the same outline
   /// but for the brackets), refined where that converged: the mount's side may choose it.
   std::optional<registration::SilhouetteResult> turned;
@@ -211,10 +212,13 @@ SilhouettePick silhouette_search(const model::AntennaModel& model, const Iso3& T
     // A descent that left its start's basin still ended near a minimum: descending again from
     // there, it is kept if it stays put (then it is a minimum like any other, and the score
     // chooses among them). Few starts sit in the right basin of a narrow panel seen face-on, and
-    // a panel partly hidden by its mast may take more than one such step to settle (1702-1).
-    for (int k = 0; k < options.silhouette_redescents && !r.converged && r.left_start; ++k) {
+    // a panel partly hidden by its mast may take more than one such step to settle (1702-1). One
+    // stopped by the iteration limit is continued alike: 2912-2's right basin (turned round) was
+    // reached by a single start, which then ran out of steps and so never competed.
+    for (int k = 0; k < options.silhouette_redescents && !r.converged; ++k) {
+      if (!r.left_start && !r.stopped_at_iteration_limit) break;
       ++pick.tried;
-      auto again = refine(*r.left_start);
+      auto again = refine(r.left_start ? *r.left_start : r.T_board_antenna);
       if (!again.converged && again.score >= r.score) break;
       r = std::move(again);
     }
@@ -230,13 +234,26 @@ SilhouettePick silhouette_search(const model::AntennaModel& model, const Iso3& T
   }
   if (done.empty()) return pick;
   std::sort(done.begin(), done.end(), [](const auto& a, const auto& b) { return a.score < b.score; });
-  const auto is_rival = [&](const registration::SilhouetteResult& r, const registration::SilhouetteResult& best) {
-    return r.score < best.score + options.silhouette_rival_margin &&
-           rad2deg(angle_between(r.T_board_antenna.linear().col(1), best.T_board_antenna.linear().col(1))) >
-               options.rival_min_deg;
+  // A converged start is a rival when it scores about as well at a boresight more than
+  // rival_min_deg away. Turned round (the same outline but for the brackets), within
+  // options.silhouette_rival_margin; at another yaw, within a margin that grows with the
+  // winner's score (options.silhouette_rival_share): where the outline fits poorly (part
+  // hidden, clutter beside it), the score's differences between poses mean less.
+  enum class Rival { kNone, kTurnedRound, kOtherYaw };
+  const auto rival = [&](const registration::SilhouetteResult& r, const registration::SilhouetteResult& best) {
+    const double angle =
+        rad2deg(angle_between(r.T_board_antenna.linear().col(1), best.T_board_antenna.linear().col(1)));
+    if (angle <= options.rival_min_deg) return Rival::kNone;
+    if (angle >= 180.0 - options.rival_min_deg)
+      return r.score < best.score + options.silhouette_rival_margin ? Rival::kTurnedRound : Rival::kNone;
+    const double margin = std::max(options.silhouette_rival_margin, options.silhouette_rival_share * best.score);
+    return r.score < best.score + margin ? Rival::kOtherYaw : Rival::kNone;
   };
   for (std::size_t i = 1; i < done.size(); ++i)
-    if (is_rival(done[i], done.front())) pick.rivals.push_back(done[i].T_board_antenna.linear());
+    if (const Rival kind = rival(done[i], done.front()); kind != Rival::kNone) {
+      pick.rivals.push_back(done[i].T_board_antenna.linear());
+      pick.rival_yaw = pick.rival_yaw || kind == Rival::kOtherYaw;
+    }
   pick.best = std::move(done.front());
   // Front and back by the outline too: the brackets show in it from the side. The winner turned
   // by 180° about its own long axis (the same line in the photos, the boresight reversed and the
@@ -252,7 +269,7 @@ SilhouettePick silhouette_search(const model::AntennaModel& model, const Iso3& T
     pick.rivals.clear();
     std::swap(flipped, *pick.best);
     pick.flipped_by_outline = true;
-  } else if (is_rival(flipped, *pick.best)) {
+  } else if (rival(flipped, *pick.best) != Rival::kNone) {
     pick.rivals.push_back(flipped.T_board_antenna.linear());
   }
   pick.turned = std::move(flipped);
@@ -276,14 +293,20 @@ Vec3 points_long_axis(const registration::PreparedCloud& cloud, const registrati
 void decide_front_by_mount(AntennaMeasurement& m, SilhouettePick& pick, const model::AntennaModel& model,
                            const registration::PreparedCloud& model_prepared, const Vec3& axis_points, double reach,
                            const Vec3& up_board, const NonContactOptions& options) {
-  auto side = count_mount_side(m.region.cloud_board, pick.best->T_board_antenna.inverse(), model_prepared.tree,
-                               model.size_m, reach, options.mount);
-  const auto downtilt = [&](const registration::SilhouetteResult& r) {
-    const Mat3& R = r.T_board_antenna.linear();
+  const auto count = [&](const Mat3& R_board_antenna) {
+    Iso3 T_board_antenna = pick.best->T_board_antenna;
+    T_board_antenna.linear() = R_board_antenna;
+    return count_mount_side(m.region.cloud_board, T_board_antenna.inverse(), model_prepared.tree, model.size_m, reach,
+                            options.mount);
+  };
+  const auto downtilt = [&](const Mat3& R) {
     const bool off_axis = rad2deg(angle_between(R.col(2), axis_points)) > options.axis_gate_deg;
     return boresight_downtilt(off_axis ? with_long_axis(R, axis_points) : R, up_board);
   };
-  const double tilt = downtilt(*pick.best), tilt_turned = pick.turned ? downtilt(*pick.turned) : -tilt;
+  const Mat3 turn = Eigen::AngleAxisd(M_PI, Vec3::UnitZ()).toRotationMatrix();
+  auto side = count(pick.best->T_board_antenna.linear());
+  const double tilt = downtilt(pick.best->T_board_antenna.linear());
+  const double tilt_turned = pick.turned ? downtilt(pick.turned->T_board_antenna.linear()) : -tilt;
   const MountVerdict mount = mount_verdict(side, options.mount);
   const FrontBack call = decide_front_back(mount, tilt, tilt_turned, deg2rad(options.max_uptilt_deg));
   const auto turn_round = [&] {
@@ -334,8 +357,22 @@ void decide_front_by_mount(AntennaMeasurement& m, SilhouettePick& pick, const mo
   }
   m.mount_points = side;
   const Vec3 boresight = pick.best->T_board_antenna.linear().col(1);
+  // Decided, a rival facing the other way within options.rival_min_deg is the result turned
+  // round, which the cues ruled out. One at another yaw has its own front and back, which the
+  // cues decide as they did the result's (2912-2: the result 67° from a rival that was the truth
+  // turned round); where they cannot, it faces as the result does.
+  if (decided)
+    for (Mat3& R : pick.rivals) {
+      const double angle = rad2deg(angle_between(R.col(1), boresight));
+      if (angle <= options.rival_min_deg || angle >= 180.0 - options.rival_min_deg) continue;
+      const Mat3 turned = R * turn;
+      const auto own = decide_front_back(mount_verdict(count(R), options.mount), downtilt(R), downtilt(turned),
+                                         deg2rad(options.max_uptilt_deg));
+      if (own.verdict == MountVerdict::kTurned || (own.verdict == MountVerdict::kUndecided && angle > 90.0)) R = turned;
+    }
   std::erase_if(pick.rivals, [&](const Mat3& R) {
-    return (decided && R.col(1).dot(boresight) < 0.0) ||
+    return (decided && R.col(1).dot(boresight) < 0.0 &&
+            rad2deg(angle_between(R.col(1), boresight)) >= 180.0 - options.rival_min_deg) ||
            rad2deg(angle_between(R.col(1), boresight)) <= options.rival_min_deg;
   });
   // One rival per place: starts that ended together would each widen the σ again.
@@ -570,7 +607,10 @@ struct OutlineSearch {
   SilhouettePick pick;
   std::optional<MastScene> with_the_mast;
   std::optional<Vec3> held_axis;
-  std::optional<double> doubtful_score;  // the free winner's poor score, when the held search beat it
+  /// Where the held search's winner was kept over the free search's: that one's score, and
+  /// whether another yaw fitted about as well.
+  std::optional<double> free_score;
+  bool free_rival_yaw = false;
 };
 
 // Known objects (the mast, the other antennas) change every start's basin: in the free search
@@ -589,23 +629,21 @@ OutlineSearch search_outline(const PointCloud& cloud_board, const model::Antenna
   // beside it lure the descents away or the mast hides part of it: where no start converged, the
   // search is repeated with the long axis held to the points' and the mast known (with_mast). So
   // it is where the free search's winner fits the outline poorly
-  // (options.silhouette_doubtful_score), and the held search's wins if it fits better: 2112-3, a
-  // thesis panel a third hidden by its mast, won the free search 79° off at 0.37 (its downtilt
-  // and roll swapped, σ 0.2°); held, 0.16.
-  const std::optional<double> doubtful_score = pick.best && pick.best->score > options.silhouette_doubtful_score
-                                                   ? std::optional(pick.best->score)
-                                                   : std::nullopt;
-  if ((!pick.best || doubtful_score) && options.held_axis_search) {
+  // (options.silhouette_doubtful_score) or another yaw fits it about as well (a rival), and the
+  // held search's wins if it fits better: 2112-3, a thesis panel a third hidden by its mast, won
+  // the free search 79° off at 0.37 (its downtilt and roll swapped, σ 0.2°); held, 0.16.
+  const bool doubtful = pick.best && (pick.best->score > options.silhouette_doubtful_score || pick.rival_yaw);
+  if ((!pick.best || doubtful) && options.held_axis_search) {
     auto with_the_mast = with_mast(cloud_board, site, T_antenna_board, model, options);
     Vec3 axis = points_long_axis(points.cloud, points.model, T_antenna_board, options);
     if (axis.dot(site.up_board) < 0.0) axis = -axis;
     auto held = silhouette_search(model, T_antenna_board.inverse(), with_the_mast.scene, options, axis);
     held.tried += pick.tried;
-    if (held.best && (!doubtful_score || held.best->score < *doubtful_score)) {
+    if (held.best && (!doubtful || held.best->score < pick.best->score)) {
+      if (pick.best) s.free_score = pick.best->score, s.free_rival_yaw = pick.rival_yaw;
       pick = std::move(held);
       s.held_axis = axis;
-      s.doubtful_score = doubtful_score;
-    } else if (doubtful_score) {
+    } else if (doubtful) {
       return s;  // the free search's winner stands, and nothing of the held search's is used
     } else {
       pick.tried = held.tried;
@@ -631,7 +669,7 @@ struct OutlineFit {
 // mast and the method into `m`.
 OutlineFit fit_outline(AntennaMeasurement& m, const model::AntennaModel& model, const PointsRegistration& points,
                        const Scene& site, const NonContactOptions& options, OutlinePass pass) {
-  auto [pick, with_the_mast, held_axis, doubtful_score] =
+  auto [pick, with_the_mast, held_axis, free_score, free_rival_yaw] =
       search_outline(m.region.cloud_board, model, points, site, options, pass);
   if (with_the_mast) m.mast = with_the_mast->mast;
   if (!pick.best)
@@ -674,8 +712,10 @@ OutlineFit fit_outline(AntennaMeasurement& m, const model::AntennaModel& model, 
         "roll are the points' and the outline fixes the yaw about their axis, within {}{:+.0f}° to {:+.0f}° of the "
         "result (a narrow panel's outline barely changes with yaw when seen face-on from below: photograph it over "
         "a wider arc or from nearer)",
-        doubtful_score ? fmt::format("poorly (score {:.2f})", *doubtful_score) : std::string("from no start"),
-        doubtful_score ? fmt::format("better ({:.2f}) ", pick.best->score) : std::string(),
+        !free_score      ? std::string("from no start")
+        : free_rival_yaw ? fmt::format("ambiguously (score {:.2f}, and another yaw about as well)", *free_score)
+                         : fmt::format("poorly (score {:.2f})", *free_score),
+        free_score ? fmt::format("better ({:.2f}) ", pick.best->score) : std::string(),
         profile.open ? "more than " : "", rad2deg(profile.low_rad), rad2deg(profile.high_rad)));
   }
   m.silhouette_rms_px = pick.best->rms_px;

@@ -81,6 +81,11 @@ struct NonContactOptions {
   bool silhouette = true;
   std::vector<double> silhouette_yaw_starts_deg = {0, 25, -25, 50, -50, 75, -75};
   double silhouette_rival_margin = 0.02;  // a converged start within this score is a rival
+  /// ... or, at another yaw, within this share of the winner's score, if more. Poses 67–79° apart
+  /// scored 0.288 and 0.343 (2912-2, the worse one right) and 0.294 and 0.368 (2112-3, the better
+  /// one right); of the right winners on 34 development sites, no other start at another yaw came
+  /// within half the winner's score.
+  double silhouette_rival_share = 0.35;
   /// A converged start whose score (the outline's mean truncated edge cost, 0 .. 1) is above this
   /// fits too little of the outline to be trusted. On the development sites 601–912 and 1008
   /// the right poses scored 0.013–0.351, the confidently wrong ones (606-3 65°, 610-1 28°,

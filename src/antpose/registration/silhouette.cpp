@@ -599,7 +599,8 @@ SilhouetteResult refine_by_silhouette(const model::Mesh& mesh_antenna, const Iso
     result.covariance = Hinv * M * Hinv;
   }
 
-  bool ok = solvable && last_level_converged;
+  // The iteration limit is judged last: alone, it leaves a descent a search may continue.
+  bool ok = solvable;
   if (!solvable)
     result.warnings.push_back("silhouette: too few contour samples found an edge to fix the pose");
   else if (!last_level_converged)
@@ -651,7 +652,8 @@ SilhouetteResult refine_by_silhouette(const model::Mesh& mesh_antenna, const Iso
         "silhouette: the pose turned {:.1f}° from the start (more than {:.1f}°): probably another local minimum",
         rad2deg(turned), rad2deg(options.max_rotation_change_rad)));
   }
-  result.converged = ok;
+  result.stopped_at_iteration_limit = ok && !last_level_converged;
+  result.converged = ok && last_level_converged;
   return result;
 }
 

@@ -132,6 +132,10 @@ struct SilhouetteResult {
   /// it, or a rival that far away scored better): the pose it reached, the better rival's if
   /// any. Then not converged; a multi-start search may descend again from there.
   std::optional<Iso3> left_start;
+  /// Set when the descent passed every check but stopped at the iteration limit
+  /// (max_iterations_per_level) still moving: not converged, and a search may continue it from
+  /// T_board_antenna.
+  bool stopped_at_iteration_limit = false;
   std::vector<std::string> warnings;
 };
 
