@@ -142,6 +142,10 @@ Mat3 with_long_axis(const Mat3& R_board_antenna, const Vec3& axis_board) {
   return Eigen::Quaterniond::FromTwoVectors(R_board_antenna.col(2), axis_board).toRotationMatrix() * R_board_antenna;
 }
 
+// R_board_antenna turned by 180° about the antenna's own long axis: front and back swapped, the
+// same line in the photos.
+Mat3 turned_round(const Mat3& R_board_antenna) { return R_board_antenna * Vec3(-1.0, -1.0, 1.0).asDiagonal(); }
+
 // The outline's options for the descents with the long axis held: monotone steps
 // (SilhouetteOptions::max_step_halvings), and twice as many of them, since monotone steps are
 // short where the score is flat and none of them can raise it.
@@ -259,7 +263,7 @@ SilhouettePick silhouette_search(const model::AntennaModel& model, const Iso3& T
   // by 180° about its own long axis (the same line in the photos, the boresight reversed and the
   // downtilt's sign with it) is refined; clearly better, it wins; about as good, it is a rival.
   Iso3 turned = pick.best->T_board_antenna;
-  turned.linear() = turned.linear() * Eigen::AngleAxisd(M_PI, Vec3::UnitZ()).toRotationMatrix();
+  turned.linear() = turned_round(turned.linear());
   auto flipped = refine(turned);
   ++pick.tried;
   if (!flipped.converged) {
@@ -303,7 +307,6 @@ void decide_front_by_mount(AntennaMeasurement& m, SilhouettePick& pick, const mo
     const bool off_axis = rad2deg(angle_between(R.col(2), axis_points)) > options.axis_gate_deg;
     return boresight_downtilt(off_axis ? with_long_axis(R, axis_points) : R, up_board);
   };
-  const Mat3 turn = Eigen::AngleAxisd(M_PI, Vec3::UnitZ()).toRotationMatrix();
   auto side = count(pick.best->T_board_antenna.linear());
   const double tilt = downtilt(pick.best->T_board_antenna.linear());
   const double tilt_turned = pick.turned ? downtilt(pick.turned->T_board_antenna.linear()) : -tilt;
@@ -365,7 +368,7 @@ void decide_front_by_mount(AntennaMeasurement& m, SilhouettePick& pick, const mo
     for (Mat3& R : pick.rivals) {
       const double angle = rad2deg(angle_between(R.col(1), boresight));
       if (angle <= options.rival_min_deg || angle >= 180.0 - options.rival_min_deg) continue;
-      const Mat3 turned = R * turn;
+      const Mat3 turned = turned_round(R);
       const auto own = decide_front_back(mount_verdict(count(R), options.mount), downtilt(R), downtilt(turned),
                                          deg2rad(options.max_uptilt_deg));
       if (own.verdict == MountVerdict::kTurned || (own.verdict == MountVerdict::kUndecided && angle > 90.0)) R = turned;
