@@ -146,6 +146,11 @@ Mat3 with_long_axis(const Mat3& R_board_antenna, const Vec3& axis_board) {
 // same line in the photos.
 Mat3 turned_round(const Mat3& R_board_antenna) { return R_board_antenna * Vec3(-1.0, -1.0, 1.0).asDiagonal(); }
 
+// The angle between two poses' boresights (y_a), degrees.
+double boresight_angle_deg(const Mat3& R_board_a, const Mat3& R_board_b) {
+  return rad2deg(angle_between(R_board_a.col(1), R_board_b.col(1)));
+}
+
 // The outline's options for the descents with the long axis held: monotone steps
 // (SilhouetteOptions::max_step_halvings), and twice as many of them, since monotone steps are
 // short where the score is flat and none of them can raise it.
@@ -245,8 +250,7 @@ SilhouettePick silhouette_search(const model::AntennaModel& model, const Iso3& T
   // hidden, clutter beside it), the score's differences between poses mean less.
   enum class Rival { kNone, kTurnedRound, kOtherYaw };
   const auto rival = [&](const registration::SilhouetteResult& r, const registration::SilhouetteResult& best) {
-    const double angle =
-        rad2deg(angle_between(r.T_board_antenna.linear().col(1), best.T_board_antenna.linear().col(1)));
+    const double angle = boresight_angle_deg(r.T_board_antenna.linear(), best.T_board_antenna.linear());
     if (angle <= options.rival_min_deg) return Rival::kNone;
     if (angle >= 180.0 - options.rival_min_deg)
       return r.score < best.score + options.silhouette_rival_margin ? Rival::kTurnedRound : Rival::kNone;
@@ -345,9 +349,8 @@ void decide_front_by_mount(AntennaMeasurement& m, SilhouettePick& pick, const mo
   // registered, 2402 and 2506-3 (ground, 1.5° and 1.9° down) came out turned round, tilting up.
   const bool decided = call.verdict != MountVerdict::kUndecided;
   const auto turned_is_rival = [&] {
-    const Vec3 boresight = pick.best->T_board_antenna.linear().col(1);
     return std::any_of(pick.rivals.begin(), pick.rivals.end(), [&](const Mat3& R) {
-      return rad2deg(angle_between(R.col(1), boresight)) > 180.0 - options.rival_min_deg;
+      return boresight_angle_deg(R, pick.best->T_board_antenna.linear()) > 180.0 - options.rival_min_deg;
     });
   };
   if (!decided && !call.in_doubt && pick.turned && tilt_turned > tilt && turned_is_rival()) {
@@ -359,14 +362,14 @@ void decide_front_by_mount(AntennaMeasurement& m, SilhouettePick& pick, const mo
     pick.rivals.push_back(pick.turned->T_board_antenna.linear());
   }
   m.mount_points = side;
-  const Vec3 boresight = pick.best->T_board_antenna.linear().col(1);
+  const Mat3& R_result = pick.best->T_board_antenna.linear();
   // Decided, a rival facing the other way within options.rival_min_deg is the result turned
   // round, which the cues ruled out. One at another yaw has its own front and back, which the
   // cues decide as they did the result's (2912-2: the result 67° from a rival that was the truth
   // turned round); where they cannot, it faces as the result does.
   if (decided)
     for (Mat3& R : pick.rivals) {
-      const double angle = rad2deg(angle_between(R.col(1), boresight));
+      const double angle = boresight_angle_deg(R, R_result);
       if (angle <= options.rival_min_deg || angle >= 180.0 - options.rival_min_deg) continue;
       const Mat3 turned = turned_round(R);
       const auto own = decide_front_back(mount_verdict(count(R), options.mount), downtilt(R), downtilt(turned),
@@ -374,16 +377,14 @@ void decide_front_by_mount(AntennaMeasurement& m, SilhouettePick& pick, const mo
       if (own.verdict == MountVerdict::kTurned || (own.verdict == MountVerdict::kUndecided && angle > 90.0)) R = turned;
     }
   std::erase_if(pick.rivals, [&](const Mat3& R) {
-    return (decided && R.col(1).dot(boresight) < 0.0 &&
-            rad2deg(angle_between(R.col(1), boresight)) >= 180.0 - options.rival_min_deg) ||
-           rad2deg(angle_between(R.col(1), boresight)) <= options.rival_min_deg;
+    const double angle = boresight_angle_deg(R, R_result);
+    return (decided && angle >= 180.0 - options.rival_min_deg) || angle <= options.rival_min_deg;
   });
   // One rival per place: starts that ended together would each widen the σ again.
   std::vector<Mat3> distinct;
   for (const Mat3& R : pick.rivals)
-    if (std::none_of(distinct.begin(), distinct.end(), [&](const Mat3& D) {
-          return rad2deg(angle_between(R.col(1), D.col(1))) <= options.rival_min_deg;
-        }))
+    if (std::none_of(distinct.begin(), distinct.end(),
+                     [&](const Mat3& D) { return boresight_angle_deg(R, D) <= options.rival_min_deg; }))
       distinct.push_back(R);
   pick.rivals = std::move(distinct);
 }
@@ -789,10 +790,9 @@ void register_model(AntennaMeasurement& m, const model::AntennaModel& model, con
           "antenna from further round its side, or check the azimuth by eye",
           g.front_back_margin));
     // Any other yaw that fits the points nearly as well (coarse scores) is a rival.
-    const Vec3 boresight = m.R_board_antenna.col(1);
     for (const auto& h : g.hypotheses) {
       const Mat3 R = h.T_model_scene.rotation().transpose();
-      const double angle = rad2deg(angle_between(R.col(1), boresight));
+      const double angle = boresight_angle_deg(R, m.R_board_antenna);
       if (angle > options.rival_min_deg && angle <= 90.0 &&
           h.score() - g.hypotheses.front().score() < options.registration.ambiguity_margin)
         m.rivals_board.push_back(R);

@@ -32,6 +32,7 @@
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "antpose/camera/board_pose.hpp"
 #include "antpose/core/statistics.hpp"
 #include "antpose/reconstruction/features.hpp"
 #include "antpose/reconstruction/reconstruct.hpp"
@@ -91,8 +92,6 @@ std::optional<DepthRange> nearest_depth_cluster(const std::vector<Vec3>& points_
 }  // namespace detail
 
 namespace {
-
-Vec3 centre_of(const Mat3& R, const Vec3& t) { return -R.transpose() * t; }
 
 /// Board-frame points on the boundary of `roi` of a view at the given depths (along the
 /// camera's z), a few per edge so that the lens distortion's curvature is followed.
@@ -190,8 +189,8 @@ PairCloud dense_pair(const DenseContext& c, int a, int b, const std::vector<cv::
   PairCloud out{a, b, {}, 0.0};
   const auto& P = *c.poses;
   const auto& K = *c.K;
-  const Vec3 Ca = centre_of(P.R_camera_board[a], P.t_camera_board[a]);
-  const Vec3 Cb = centre_of(P.R_camera_board[b], P.t_camera_board[b]);
+  const Vec3 Ca = camera::camera_centre(P.R_camera_board[a], P.t_camera_board[a]);
+  const Vec3 Cb = camera::camera_centre(P.R_camera_board[b], P.t_camera_board[b]);
   const double baseline = (Cb - Ca).norm();
   // Rectified frame: x along the baseline (so disparities u_a − u_b are positive), z towards the
   // object, y = z × x.
@@ -543,8 +542,8 @@ RegionReconstruction reconstruct_region(const std::vector<PosedView>& views, con
     for (std::size_t i = 0; i < seen_by.size(); ++i)
       for (std::size_t j = i + 1; j < seen_by.size(); ++j) {
         const int a = seen_by[i], b = seen_by[j];
-        const double angle = angle_between(centre_of(poses.R_camera_board[a], poses.t_camera_board[a]) - O,
-                                           centre_of(poses.R_camera_board[b], poses.t_camera_board[b]) - O);
+        const double angle = angle_between(camera::camera_centre(poses.R_camera_board[a], poses.t_camera_board[a]) - O,
+                                           camera::camera_centre(poses.R_camera_board[b], poses.t_camera_board[b]) - O);
         if (angle < deg2rad(3) || angle > deg2rad(40)) continue;
         candidates.emplace_back(std::abs(angle - deg2rad(15)), a, b);
       }
@@ -674,7 +673,7 @@ RegionReconstruction reconstruct_region(const std::vector<PosedView>& views, con
   registration::KdTree tree(cloud.points);
   cloud.normals = registration::estimate_normals(tree, 12);
   std::vector<Vec3> centres;
-  for (int v : seen_by) centres.push_back(centre_of(poses.R_camera_board[v], poses.t_camera_board[v]));
+  for (int v : seen_by) centres.push_back(camera::camera_centre(poses.R_camera_board[v], poses.t_camera_board[v]));
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     double best = -1, sign = 1;
     for (const auto& c : centres) {
