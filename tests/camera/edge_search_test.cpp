@@ -33,13 +33,16 @@ TEST(EdgeSearch, FindsAStepToAQuarterPixelInLinearIntensity) {
     const auto [gx, gy] = smoothed_gradients(linear_intensity(step_image(edge), 2.2), 1.0);
     // From left and right of the edge, along +x: the signed distance to it.
     for (const double from : {24.0, 36.0}) {
-      const auto d = nearest_edge(gx, gy, Vec2(from, 20.0), Vec2(1.0, 0.0), 10.0, 3.0, scratch);
+      const auto d =
+          nearest_edge(gx, gy, Vec2(from, 20.0), Vec2(1.0, 0.0), EdgeSearchSpan::symmetric(10.0), 3.0, scratch);
       ASSERT_TRUE(d.has_value()) << edge << " " << from;
       EXPECT_NEAR(from + *d, edge, 0.27) << edge << " " << from;
     }
     // Out of reach, or along the edge: none.
-    EXPECT_FALSE(nearest_edge(gx, gy, Vec2(10.0, 20.0), Vec2(1.0, 0.0), 5.0, 3.0, scratch).has_value());
-    EXPECT_FALSE(nearest_edge(gx, gy, Vec2(30.0, 20.0), Vec2(0.0, 1.0), 10.0, 3.0, scratch).has_value());
+    EXPECT_FALSE(nearest_edge(gx, gy, Vec2(10.0, 20.0), Vec2(1.0, 0.0), EdgeSearchSpan::symmetric(5.0), 3.0, scratch)
+                     .has_value());
+    EXPECT_FALSE(nearest_edge(gx, gy, Vec2(30.0, 20.0), Vec2(0.0, 1.0), EdgeSearchSpan::symmetric(10.0), 3.0, scratch)
+                     .has_value());
   }
 }
 
@@ -55,7 +58,7 @@ TEST(EdgeSearch, TakesTheNearestStrongEdgeAndNeverAMaskedOne) {
   auto [gx, gy] = smoothed_gradients(linear_intensity(m, 0.0), 1.0);
   std::vector<double> scratch;
   const auto nearest = [&](double x) {
-    return nearest_edge(gx, gy, Vec2(x, 20.0), Vec2(1.0, 0.0), 25.0, 3.0, scratch);
+    return nearest_edge(gx, gy, Vec2(x, 20.0), Vec2(1.0, 0.0), EdgeSearchSpan::symmetric(25.0), 3.0, scratch);
   };
   ASSERT_TRUE(nearest(45.0).has_value());
   EXPECT_NEAR(45.0 + *nearest(45.0), 29.5, 0.3);  // 15.5 px left; the weak step 14.5 px right is ignored
@@ -65,6 +68,25 @@ TEST(EdgeSearch, TakesTheNearestStrongEdgeAndNeverAMaskedOne) {
   gx.setTo(0, mask), gy.setTo(0, mask);
   ASSERT_TRUE(nearest(52.0).has_value());
   EXPECT_NEAR(52.0 + *nearest(52.0), 29.5, 0.3);  // the masked step is not there any more
+}
+
+// A panel narrower than the search range, 20 px wide: its edge against a dark mast (left) is
+// weaker in linear intensity than its far edge against the bright sky. Searched both ways the far
+// edge is the nearest strong one; with the line behind the outline ending at the panel's middle,
+// the panel's own edge is found.
+TEST(EdgeSearch, ALineEndingBehindAtThePanelsMiddleFindsItsOwnWeakerEdge) {
+  cv::Mat m(40, 100, CV_8UC1, cv::Scalar(100));  // mast
+  m.colRange(30, 50).setTo(150);                 // panel: edges at 29.5 and 49.5
+  m.colRange(50, 100).setTo(235);                // sky
+  const auto [gx, gy] = smoothed_gradients(linear_intensity(m, 2.2), 1.0);
+  std::vector<double> scratch;
+  const Vec2 outward(-1.0, 0.0);  // the panel's left outline, predicted at x = 31
+  const auto both_ways = nearest_edge(gx, gy, Vec2(31.0, 20.0), outward, EdgeSearchSpan::symmetric(25.0), 3.0, scratch);
+  ASSERT_TRUE(both_ways.has_value());
+  EXPECT_NEAR(31.0 - *both_ways, 49.5, 0.3);
+  const auto own = nearest_edge(gx, gy, Vec2(31.0, 20.0), outward, {10.0, 25.0}, 3.0, scratch);
+  ASSERT_TRUE(own.has_value());
+  EXPECT_NEAR(31.0 - *own, 29.5, 0.3);
 }
 
 }  // namespace

@@ -28,6 +28,9 @@ Vec3 axis_errors_deg(const Mat3& R_est, const Mat3& R_true) {
   return (R_true.transpose() * log_so3(R_est * R_true.transpose())) * (180.0 / std::numbers::pi);
 }
 
+// Front and back swapped: turned by 180° about the antenna's own long axis.
+Mat3 turned_round(const Mat3& R_board_antenna) { return R_board_antenna * Vec3(-1, -1, 1).asDiagonal(); }
+
 // The start of the brief: 5° about the long axis, 2° about the others, 5 cm.
 Iso3 perturbed(const Iso3& T_true, double yaw_deg, double other_deg, const Vec3& dt) {
   const Mat3 R = T_true.linear();
@@ -438,6 +441,46 @@ TEST(Silhouette, AMonotoneDescentWithTheAxisHeldKeepsANarrowPanelsOutline) {
   }
 }
 
+// The brackets' outline runs into the arms that hold them, which the model lacks, so it is found
+// a pixel or two off; at the back plate's lever arm that turned a narrow panel's yaw by 4.8°
+// (development site 2902-1, from the truth as the start). With the model's box given, outline
+// points on the brackets are no samples of the fit; their edge costs go into the whole
+// outline's score, which still tells the back from the front.
+TEST(Silhouette, TheBracketsOutlineTellsTheBackButIsNotFitted) {
+  static const SyntheticScene s = [] {
+    SceneSpec spec;  // the thesis's panel on a rooftop, seen from the side and behind
+    spec.panel.width_m = 0.159, spec.panel.depth_m = 0.08;
+    spec.view_offsets_deg = {100.0, 110.0, 120.0, 130.0};
+    return make_scene(spec);
+  }();
+  SilhouetteOptions whole, box;
+  box.outline_box_m = Vec3(0.159, 0.08, 1.31);
+  for (auto* o : {&whole, &box}) o->max_iterations_per_level = 0, o->rival_yaw_offsets_rad.clear();
+  const Iso3 turned = iso(turned_round(s.T_board_antenna.linear()), s.T_board_antenna.translation());
+  for (const Iso3& T : {s.T_board_antenna, turned}) {
+    const auto w = refine_by_silhouette(s.mesh_antenna, T, s.views, s.intrinsics, whole);
+    const auto b = refine_by_silhouette(s.mesh_antenna, T, s.views, s.intrinsics, box);
+    std::printf("whole outline: score %.3f, %zu samples; box: score %.3f, %zu samples, with the brackets %.3f\n",
+                w.score, w.samples, b.score, b.samples, b.score_with_attachments);
+    EXPECT_EQ(w.score_with_attachments, w.score);  // no box: all of it is the box's outline
+    EXPECT_NEAR(b.score_with_attachments, w.score, 1e-9);
+    EXPECT_LT(b.samples, w.samples);
+  }
+  // Turned round, the brackets would stand before the radome, where the photos show nothing.
+  const double ahead =
+      refine_by_silhouette(s.mesh_antenna, s.T_board_antenna, s.views, s.intrinsics, box).score_with_attachments;
+  const double round = refine_by_silhouette(s.mesh_antenna, turned, s.views, s.intrinsics, box).score_with_attachments;
+  EXPECT_GT(round, ahead + 0.1);
+  // Refined from 5° off, the box's outline alone places the panel.
+  box.max_iterations_per_level = SilhouetteOptions{}.max_iterations_per_level;
+  const auto r = refine_by_silhouette(s.mesh_antenna, perturbed(s.T_board_antenna, 5.0, 1.0, Vec3(0.02, -0.02, 0.02)),
+                                      s.views, s.intrinsics, box);
+  const Vec3 after = axis_errors_deg(r.T_board_antenna.linear(), s.T_board_antenna.linear());
+  std::printf("from 5° off: %.2f %.2f %.2f°, converged %d\n", after.x(), after.y(), after.z(), r.converged);
+  EXPECT_TRUE(r.converged);
+  EXPECT_LT(after.cwiseAbs().maxCoeff(), 1.0);
+}
+
 TEST(Silhouette, AntennaOutsideTheViewsIsReported) {
   const auto away = make_scene({.look_away = true});
   const Iso3 start = perturbed(away.T_board_antenna, 5.0, 2.0, Vec3(0.03, -0.03, 0.025));
@@ -498,6 +541,7 @@ TEST(Silhouette, DISABLED_SimulatedCapture) {
   }
   const double yaw = std::getenv("SIL_YAW_DEG") ? std::atof(std::getenv("SIL_YAW_DEG")) : 5.0;
   SilhouetteOptions o;
+  o.outline_box_m = panel.size_m;  // as measure fits it
   if (const char* e = std::getenv("SIL_SIGMA")) o.smoothing_sigma_px = std::atof(e);
   if (const char* e = std::getenv("SIL_GAMMA")) o.gamma = std::atof(e);
   if (const char* e = std::getenv("SIL_SPACING")) o.sample_spacing_px = std::atof(e);

@@ -37,26 +37,28 @@ float bilinear(const cv::Mat& m, double x, double y) {
 }
 
 std::optional<double> nearest_edge(const cv::Mat& gx, const cv::Mat& gy, const Vec2& centre, const Vec2& normal,
-                                   double half_range_px, double min_gradient, std::vector<double>& g, double relative,
+                                   EdgeSearchSpan span, double min_gradient, std::vector<double>& g, double relative,
                                    double step_px) {
-  const int half = static_cast<int>(std::ceil(half_range_px / step_px));
-  g.assign(static_cast<std::size_t>(2 * half + 1), 0.0);
+  // g[i] is the gradient (i - behind) steps along the normal.
+  const int behind = static_cast<int>(std::ceil(std::max(0.0, span.behind_px) / step_px));
+  const int ahead = static_cast<int>(std::ceil(std::max(0.0, span.ahead_px) / step_px));
+  g.assign(static_cast<std::size_t>(behind + ahead + 1), 0.0);
   double gmax = 0;
-  for (int i = -half; i <= half; ++i) {
+  for (int i = -behind; i <= ahead; ++i) {
     const Vec2 z = centre + (i * step_px) * normal;
-    g[i + half] = std::abs(bilinear(gx, z.x(), z.y()) * normal.x() + bilinear(gy, z.x(), z.y()) * normal.y());
-    gmax = std::max(gmax, g[i + half]);
+    g[i + behind] = std::abs(bilinear(gx, z.x(), z.y()) * normal.x() + bilinear(gy, z.x(), z.y()) * normal.y());
+    gmax = std::max(gmax, g[i + behind]);
   }
   if (gmax < min_gradient) return std::nullopt;
   int best = -1;
   for (int i = 1; i + 1 < static_cast<int>(g.size()); ++i) {
     if (g[i] < relative * gmax || g[i] < min_gradient || g[i] < g[i - 1] || g[i] < g[i + 1]) continue;
-    if (best < 0 || std::abs(i - half) < std::abs(best - half)) best = i;
+    if (best < 0 || std::abs(i - behind) < std::abs(best - behind)) best = i;
   }
   if (best < 0) return std::nullopt;
   const double den = g[best - 1] - 2 * g[best] + g[best + 1];
   const double sub = den < 0 ? std::clamp(0.5 * (g[best - 1] - g[best + 1]) / den, -0.5, 0.5) : 0.0;
-  return ((best - half) + sub) * step_px;
+  return ((best - behind) + sub) * step_px;
 }
 
 }  // namespace antpose::camera

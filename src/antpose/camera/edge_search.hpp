@@ -23,14 +23,20 @@ cv::Mat linear_intensity(const cv::Mat& grey8, double gamma);
 /// `sigma_px`.
 std::pair<cv::Mat, cv::Mat> smoothed_gradients(const cv::Mat& image, double sigma_px);
 
+/// The search line of nearest_edge, px: from `behind_px` against the normal to `ahead_px` along it.
+struct EdgeSearchSpan {
+  double behind_px = 0, ahead_px = 0;
+  static EdgeSearchSpan symmetric(double half_range_px) { return {half_range_px, half_range_px}; }
+};
+
 /// The signed distance (px of the gradient images, along `normal`) from `centre` to the nearest
-/// strong edge within ±half_range_px: a local maximum of the gradient's component along the
+/// strong edge on the search line `span`: a local maximum of the gradient's component along the
 /// normal, at least `min_gradient` and at least `relative` × the strongest on the line, located
 /// to sub-pixel by a parabola. Searched in steps of `step_px` (bilinear), gradients of 0 (masked
 /// parts of the image) are never edges. nullopt when there is none. `scratch` avoids a
 /// reallocation per call.
 std::optional<double> nearest_edge(const cv::Mat& gx, const cv::Mat& gy, const Vec2& centre, const Vec2& normal,
-                                   double half_range_px, double min_gradient, std::vector<double>& scratch,
+                                   EdgeSearchSpan span, double min_gradient, std::vector<double>& scratch,
                                    double relative = 0.5, double step_px = 0.5);
 
 /// Bilinear sample of a CV_32F image at (x, y); 0 outside.

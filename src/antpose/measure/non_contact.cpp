@@ -245,15 +245,18 @@ SilhouettePick silhouette_search(const model::AntennaModel& model, const Iso3& T
   std::sort(done.begin(), done.end(), [](const auto& a, const auto& b) { return a.score < b.score; });
   // A converged start is a rival when it scores about as well at a boresight more than
   // rival_min_deg away. Turned round (the same outline but for the brackets), within
-  // options.silhouette_rival_margin; at another yaw, within a margin that grows with the
-  // winner's score (options.silhouette_rival_share): where the outline fits poorly (part
-  // hidden, clutter beside it), the score's differences between poses mean less.
+  // options.silhouette_rival_margin with the brackets' outline counted; at another yaw, within a
+  // margin that grows with the winner's score (options.silhouette_rival_share): where the
+  // outline fits poorly (part hidden, clutter beside it), the score's differences between poses
+  // mean less.
   enum class Rival { kNone, kTurnedRound, kOtherYaw };
   const auto rival = [&](const registration::SilhouetteResult& r, const registration::SilhouetteResult& best) {
     const double angle = boresight_angle_deg(r.T_board_antenna.linear(), best.T_board_antenna.linear());
     if (angle <= options.rival_min_deg) return Rival::kNone;
     if (angle >= 180.0 - options.rival_min_deg)
-      return r.score < best.score + options.silhouette_rival_margin ? Rival::kTurnedRound : Rival::kNone;
+      return r.score_with_attachments < best.score_with_attachments + options.silhouette_rival_margin
+                 ? Rival::kTurnedRound
+                 : Rival::kNone;
     const double margin = std::max(options.silhouette_rival_margin, options.silhouette_rival_share * best.score);
     return r.score < best.score + margin ? Rival::kOtherYaw : Rival::kNone;
   };
@@ -265,7 +268,8 @@ SilhouettePick silhouette_search(const model::AntennaModel& model, const Iso3& T
   pick.best = std::move(done.front());
   // Front and back by the outline too: the brackets show in it from the side. The winner turned
   // by 180° about its own long axis (the same line in the photos, the boresight reversed and the
-  // downtilt's sign with it) is refined; clearly better, it wins; about as good, it is a rival.
+  // downtilt's sign with it) is refined; clearly better with the brackets' outline counted, it
+  // wins; about as good, it is a rival.
   Iso3 turned = pick.best->T_board_antenna;
   turned.linear() = turned_round(turned.linear());
   auto flipped = refine(turned);
@@ -273,7 +277,7 @@ SilhouettePick silhouette_search(const model::AntennaModel& model, const Iso3& T
   if (!flipped.converged) {
     flipped = *pick.best;
     flipped.T_board_antenna = turned;
-  } else if (flipped.score < pick.best->score - options.silhouette_rival_margin) {
+  } else if (flipped.score_with_attachments < pick.best->score_with_attachments - options.silhouette_rival_margin) {
     pick.rivals.clear();
     std::swap(flipped, *pick.best);
     pick.flipped_by_outline = true;
@@ -746,7 +750,11 @@ OutlineFit fit_outline(AntennaMeasurement& m, const model::AntennaModel& model, 
 // The model registered to the region: by its points, then its outline (fit_outline); the
 // pose's covariance from the outline, or else by resampling the points; the fit's checks.
 void register_model(AntennaMeasurement& m, const model::AntennaModel& model, const PointsRegistration& points,
-                    const Scene& site, const NonContactOptions& options, OutlinePass pass = OutlinePass::kFirst) {
+                    const Scene& site, const NonContactOptions& common, OutlinePass pass = OutlinePass::kFirst) {
+  // The outline places the model by its box alone; the brackets' outline only tells front from
+  // back (registration::SilhouetteOptions::outline_box_m).
+  NonContactOptions options = common;
+  options.silhouette_options.outline_box_m = model.size_m;
   const auto& g = points.start;
   Iso3 T_antenna_board = g.fit.T_target_source;
   m.method = "model " + model.name + ", points";

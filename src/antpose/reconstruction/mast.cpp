@@ -272,7 +272,8 @@ std::size_t outline_tangencies(const std::vector<EdgeView>& edge_views, const Ho
         const Vec2 q = *a + (*b - *a) * ((j + 0.5) / n);
         ++sampled;
         const auto edge =
-            camera::nearest_edge(ev.gx, ev.gy, q - ev.offset, normal, search_px, o.min_edge_gradient, scratch);
+            camera::nearest_edge(ev.gx, ev.gy, q - ev.offset, normal, camera::EdgeSearchSpan::symmetric(search_px),
+                                 o.min_edge_gradient, scratch);
         if (edge)
           found.push_back(
               {ev.centre_board, ev.view->R_camera_board.transpose() * K.ray(q + *edge * normal), px_per_m, vi});

@@ -142,11 +142,28 @@ std::optional<cv::Rect2d> projected_box(const camera::CameraIntrinsics& K, const
   return cv::Rect2d(x0, y0, x1 - x0, y1 - y0);
 }
 
+// Outline points of one view, counted: those on the model's box (candidates, of which some fall
+// outside the crop) and those on its attachments (options.outline_box_m), whose edge costs (as in
+// score()) are summed but which are not samples of the fit.
+struct OutlineCounts {
+  std::size_t candidates = 0, outside = 0, attachment_candidates = 0;
+  double attachment_cost = 0;
+  OutlineCounts& operator+=(const OutlineCounts& c) {
+    candidates += c.candidates, outside += c.outside, attachment_candidates += c.attachment_candidates;
+    attachment_cost += c.attachment_cost;
+    return *this;
+  }
+};
+
+// A sample's cost in score(): its squared distance truncated at score_cutoff_px, 1 without an edge.
+double edge_cost(std::optional<double> r_px, const SilhouetteOptions& o) {
+  return r_px ? std::min(1.0, (*r_px * *r_px) / (o.score_cutoff_px * o.score_cutoff_px)) : 1.0;
+}
+
 // The outer contour samples of one view at `level` with their edge measurements.
 void gather(const EdgeMesh& m, const Pose& pose, const PreparedView& v, const camera::CameraIntrinsics& K, int level,
-            double search_px, const SilhouetteOptions& o, std::vector<Sample>& out, std::size_t& candidates,
-            std::size_t& outside) {
-  candidates = outside = 0;
+            double search_px, const SilhouetteOptions& o, std::vector<Sample>& out, OutlineCounts& counts) {
+  counts = {};
   if (!v.usable) return;
   const double scale = std::ldexp(1.0, level);
   // Camera centre in the antenna frame decides which faces look at the camera.
@@ -194,7 +211,20 @@ void gather(const EdgeMesh& m, const Pose& pose, const PreparedView& v, const ca
     const int x = static_cast<int>(std::lround(q.x())), y = static_cast<int>(std::lround(q.y()));
     return x >= 0 && y >= 0 && x < mask.cols && y < mask.rows && mask.at<std::uint8_t>(y, x) != 0;
   };
+  // The projection's extent behind an outline point (mask px against its outward normal), up to
+  // twice the search range: beyond, it does not limit the search.
+  const double max_depth = 2 * search_px * scale / ms + 2;
+  auto depth_inside = [&](const Vec2& q, const Vec2& outward) {
+    double depth = 1;
+    while (depth < max_depth && inside(q - depth * outward)) depth += 1;
+    return depth;
+  };
 
+  const Vec3 half_box = o.outline_box_m / 2 + Vec3::Constant(o.box_tolerance_m);
+  const bool whole_outline = !(o.outline_box_m.array() > 0).all();
+  auto on_box = [&](const Vec3& p_antenna) {
+    return whole_outline || (p_antenna.cwiseAbs().array() <= half_box.array()).all();
+  };
   const cv::Mat& gx = v.gx[level];
   const cv::Mat& gy = v.gy[level];
   std::vector<double> g;
@@ -205,10 +235,13 @@ void gather(const EdgeMesh& m, const Pose& pose, const PreparedView& v, const ca
     for (std::size_t i = 1; i < e.faces.size(); ++i) silhouette |= front[e.faces[i]] != front[e.faces[0]];
     if (!silhouette) continue;
     const Vec2 pa = *uv[e.a], pb = *uv[e.b];
+    const Vec3& a_antenna = m.vertices[e.a];
+    const Vec3& b_antenna = m.vertices[e.b];
     const int n = static_cast<int>(std::floor((pb - pa).norm() / spacing));
     const Vec3 A = pose.R * m.vertices[e.a] + pose.t, B = pose.R * m.vertices[e.b] + pose.t;
     for (int j = 0; j < n; ++j) {
       const double s = (j + 0.5) / n, ds = 0.25 / n;
+      const bool attachment = !on_box(a_antenna + (b_antenna - a_antenna) * s);
       const Vec3 X = A + (B - A) * s;
       const auto p = project(K, v, X);
       const auto p0 = project(K, v, A + (B - A) * (s - ds));
@@ -222,16 +255,32 @@ void gather(const EdgeMesh& m, const Pose& pose, const PreparedView& v, const ca
       if (in_minus == in_plus) continue;  // inner edge, or hidden by another part of the model
       if (in_plus) normal = -normal;
       if (masked(v, level, *p)) continue;  // hidden, or where a known object's edge would be taken for it
-      ++candidates;
       const Vec2 in_crop = *p - v.offset;
-      if (in_crop.x() < 0 || in_crop.y() < 0 || in_crop.x() > v.size.width - 1 || in_crop.y() > v.size.height - 1) {
-        ++outside;
+      const bool in_view =
+          in_crop.x() >= 0 && in_crop.y() >= 0 && in_crop.x() <= v.size.width - 1 && in_crop.y() <= v.size.height - 1;
+      if (attachment) {
+        ++counts.attachment_candidates;
+      } else {
+        ++counts.candidates;
+        if (!in_view) ++counts.outside;
+      }
+      if (!in_view) {
+        if (attachment) counts.attachment_cost += edge_cost(std::nullopt, o);
         continue;
       }
       // 1-D search along the normal for the nearest strong edge (Drummond & Cipolla 2002); the
-      // masked parts' gradients are 0, so a nearer object's edge is never taken.
+      // masked parts' gradients are 0, so a nearer object's edge is never taken. Behind the
+      // outline the line ends at the projection's middle: beyond it lies the far side of the
+      // model's own outline, and on a panel narrower than the search range that far side (against
+      // the sky, say, where this side is against a grey mast) is often the stronger edge: taken
+      // for this side's, or ranking this side's as too weak, it pulls the pose across the panel.
+      const double behind = std::min(search_px, 0.5 * depth_inside(q, normal) * ms / scale);
       const auto edge =
-          camera::nearest_edge(gx, gy, (*p - v.offset) / scale, normal, search_px, o.min_edge_gradient, g);
+          camera::nearest_edge(gx, gy, (*p - v.offset) / scale, normal, {behind, search_px}, o.min_edge_gradient, g);
+      if (attachment) {
+        counts.attachment_cost += edge_cost(edge ? std::optional<double>(*edge * scale) : std::nullopt, o);
+        continue;
+      }
       if (!edge) continue;
       Sample smp;
       smp.normal = normal;
@@ -264,21 +313,20 @@ void gather(const EdgeMesh& m, const Pose& pose, const PreparedView& v, const ca
 
 struct Gathered {
   std::vector<std::vector<Sample>> per_view;
-  std::size_t candidates = 0, outside = 0, views_with_samples = 0;
+  OutlineCounts counts;
+  std::size_t views_with_samples = 0;
 };
 
 Gathered gather_all(const EdgeMesh& m, const Pose& pose, const std::vector<PreparedView>& views,
                     const camera::CameraIntrinsics& K, int level, double search_px, const SilhouetteOptions& o) {
   Gathered g;
   g.per_view.resize(views.size());
-  std::vector<std::size_t> candidates(views.size(), 0), outside(views.size(), 0);
+  std::vector<OutlineCounts> counts(views.size());
   cv::parallel_for_(cv::Range(0, static_cast<int>(views.size())), [&](const cv::Range& r) {
-    for (int i = r.start; i < r.end; ++i)
-      gather(m, pose, views[i], K, level, search_px, o, g.per_view[i], candidates[i], outside[i]);
+    for (int i = r.start; i < r.end; ++i) gather(m, pose, views[i], K, level, search_px, o, g.per_view[i], counts[i]);
   });
   for (std::size_t i = 0; i < views.size(); ++i) {
-    g.candidates += candidates[i];
-    g.outside += outside[i];
+    g.counts += counts[i];
     g.views_with_samples += g.per_view[i].empty() ? 0 : 1;
   }
   return g;
@@ -352,17 +400,20 @@ std::optional<Vec6> solve(const Normal& n, const std::array<bool, 6>& free, Mat6
 
 // Mean truncated quadratic cost of the outline at full resolution, in [0, 1]: 0 when every
 // contour sample lies on an edge, 1 per sample without an edge within score_cutoff_px (fixed, so
-// that poses compare; chamfer-like, Barrow et al. 1977).
-double score(const Gathered& g, const SilhouetteOptions& o) {
-  if (g.candidates == 0) return 1.0;
-  double sum = 0;
+// that poses compare; chamfer-like, Barrow et al. 1977). The box's outline, or with
+// `with_attachments` the whole outline.
+double score(const Gathered& g, const SilhouetteOptions& o, bool with_attachments = false) {
+  const OutlineCounts& c = g.counts;
+  const std::size_t candidates = c.candidates + (with_attachments ? c.attachment_candidates : 0);
+  if (candidates == 0) return 1.0;
+  double sum = with_attachments ? c.attachment_cost : 0.0;
   std::size_t found = 0;
   for (const auto& v : g.per_view)
     for (const auto& s : v) {
-      sum += std::min(1.0, (s.r * s.r) / (o.score_cutoff_px * o.score_cutoff_px));
+      sum += edge_cost(s.r, o);
       ++found;
     }
-  return (sum + double(g.candidates - found)) / double(g.candidates);
+  return (sum + double(c.candidates - found)) / double(candidates);
 }
 
 // Adds the rotation prior to the normal equations as a measurement of the edges' units: its
@@ -566,12 +617,13 @@ SilhouetteResult refine_by_silhouette(const model::Mesh& mesh_antenna, const Iso
 
   // Statistics and covariance at the solution (full resolution, fine search).
   const Gathered g = gather_all(m, pose, prepared, intrinsics, 0, options.fine_search_px, options);
+  result.score_with_attachments = score(g, options, true);
   Normal n = normal_equations(g, 1.0, options);
   const double prior_weight = n.inliers > 12 ? add_prior(n, pose.R, prior, options) : 0.0;
   result.T_board_antenna = pose.T();
   result.views_used = g.views_with_samples;
   result.samples = n.inliers;
-  result.inlier_fraction = g.candidates ? double(n.inliers) / double(g.candidates) : 0.0;
+  result.inlier_fraction = g.counts.candidates ? double(n.inliers) / double(g.counts.candidates) : 0.0;
   Mat6 Hinv;
   const bool solvable = n.inliers > 12 && solve(n, options.free, &Hinv).has_value();
   if (solvable) {
@@ -606,7 +658,7 @@ SilhouetteResult refine_by_silhouette(const model::Mesh& mesh_antenna, const Iso
   else if (!last_level_converged)
     result.warnings.push_back(fmt::format("silhouette: no convergence within {} iterations at full resolution",
                                           options.max_iterations_per_level));
-  const double outside = g.candidates ? double(g.outside) / double(g.candidates) : 0.0;
+  const double outside = g.counts.candidates ? double(g.counts.outside) / double(g.counts.candidates) : 0.0;
   if (outside > options.max_outside_fraction) {
     ok = false;
     result.warnings.push_back(

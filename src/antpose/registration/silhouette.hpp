@@ -13,11 +13,13 @@
 // the OUTER contour are kept (a rasterised mask must be filled just inside and empty just
 // outside: inner shading edges and parts hidden by the brackets are not geometry). Along each
 // sample's normal a 1-D search finds the nearest strong edge (gradient along the normal, a local
-// maximum of its magnitude, ≥ half the strongest on the line; sub-pixel by a parabola); the
-// residual is the signed distance. Gauss–Newton with Tukey's biweight (scale from the MAD) solves
-// for the pose, each step's rotation held within a trust region (max_step_rotation_rad: the yaw
-// about the long axis is weakly fixed and a free step can jump basins); silhouettes are
-// re-extracted every iteration. A Gaussian pyramid (cv::pyrDown) runs coarse-to-fine: wide
+// maximum of its magnitude, ≥ half the strongest on the line; sub-pixel by a parabola; behind the
+// outline the line ends at the projection's middle, short of the model's own far side); the
+// residual is the signed distance. Outline points off the model's box (brackets, whose outline
+// runs into the arms that hold them) are measured for the score with attachments only.
+// Gauss–Newton with Tukey's biweight (scale from the MAD) solves for the pose, each step's
+// rotation held within a trust region (max_step_rotation_rad: the yaw about the long axis is
+// weakly fixed and a free step can jump basins); silhouettes are re-extracted every iteration. A Gaussian pyramid (cv::pyrDown) runs coarse-to-fine: wide
 // searches on blurred images first (inner shading gone), ±4 px last. Optionally a monotone
 // descent at full resolution: a step that raises the score is halved, as a line search would
 // (Nocedal & Wright, Numerical Optimization, ch. 3), and none lowering it ends the descent.
@@ -94,6 +96,13 @@ struct SilhouetteOptions {
   double correlation_length_px = 12;  // covariance inflation (see the file comment)
   double shape_tolerance_m = 0.001;   // model vs real panel, per mesh edge (covariance)
   double edge_bias_px = 0.1;          // edge-localisation bias per mesh edge, all views (covariance)
+  // The model's box (width, depth, height along x_a, y_a, z_a, centred at the antenna frame's
+  // origin); outline points more than box_tolerance_m outside it (brackets and mounting parts on
+  // the back plate) are not measured: in a photo their outline runs into the arms and clamps that
+  // hold them, which the model lacks, and at the back plate's lever arm that bias turns the yaw.
+  // They still hide what lies behind them. Zero: every outline point is measured.
+  Vec3 outline_box_m = Vec3::Zero();
+  double box_tolerance_m = 0.002;
   std::array<bool, 6> free{true, true, true, true, true, true};  // rotation δ x, y, z (board), translation x, y, z
   // Rivals: descents from the solution turned by these angles about the long axis (file comment).
   std::vector<double> rival_yaw_offsets_rad{deg2rad(-30.0), deg2rad(30.0)};  // empty: none
@@ -124,6 +133,9 @@ struct SilhouetteResult {
   double rms_px = 0;  // weighted edge-distance RMS of the samples used, full resolution
   double inlier_fraction = 0;
   double score = 1;  // mean truncated cost of the outline, 0 (perfect) .. 1 (no edge found)
+  /// The same over the whole outline, attachments outside SilhouetteOptions::outline_box_m
+  /// included: too biased to place the model, but they tell its back from its front.
+  double score_with_attachments = 1;
   double rival_score = 1, rival_rotation_rad = 0;  // best distinct rival minimum, if any
   std::size_t views_used = 0, samples = 0;
   int iterations = 0;  // Gauss–Newton steps over all descents (start and rivals)
