@@ -202,10 +202,17 @@ SilhouettePick silhouette_search(const model::AntennaModel& model, const Iso3& T
   // is not kept: on a cluttered region it can be the wrong basin for the outline. With a held
   // axis the starts lie on it and every descent keeps it (refine_holding_axis).
   const Vec3 up = held_axis ? held_axis->normalized() : Vec3(scene.up_board.normalized());
-  const auto refine = [&](const Iso3& start) {
-    return held_axis ? refine_holding_axis(model, start, *held_axis, scene, held_axis_descent(options))
-                     : registration::refine_by_silhouette(model.mesh_antenna, start, views, scene.intrinsics,
-                                                          options.silhouette_options);
+  // Every start descends with both edge searches (SilhouetteOptions::line_ends_at_middle), and
+  // the scores, on the same fine search, choose: on a panel narrower than the search range its
+  // far side is often the stronger edge and lures the descents across it (2902-1, refused; 610-1,
+  // its downtilt 1.4° off), while a line ending at the middle lacks the reach to turn a 2 m
+  // panel's axis by 9° from upright (1302-1) or to find a thesis panel's outline 15 cm from the
+  // points' place (3206-3).
+  const auto refine = [&](const Iso3& start, bool line_ends_at_middle) {
+    auto o = held_axis ? held_axis_descent(options) : options.silhouette_options;
+    o.line_ends_at_middle = line_ends_at_middle;
+    return held_axis ? refine_holding_axis(model, start, *held_axis, scene, o)
+                     : registration::refine_by_silhouette(model.mesh_antenna, start, views, scene.intrinsics, o);
   };
   Vec3 ahead = T_board_antenna.linear().col(1) - T_board_antenna.linear().col(1).dot(up) * up;
   if (ahead.norm() < 1e-6) ahead = up.unitOrthogonal();
@@ -216,30 +223,32 @@ SilhouettePick silhouette_search(const model::AntennaModel& model, const Iso3& T
     start.linear().col(0) = y.cross(up);
     start.linear().col(1) = y;
     start.linear().col(2) = up;
-    ++pick.tried;
-    auto r = refine(start);
-    // A descent that left its start's basin still ended near a minimum: descending again from
-    // there, it is kept if it stays put (then it is a minimum like any other, and the score
-    // chooses among them). Few starts sit in the right basin of a narrow panel seen face-on, and
-    // a panel partly hidden by its mast may take more than one such step to settle (1702-1). One
-    // stopped by the iteration limit is continued alike: 2912-2's right basin (turned round) was
-    // reached by a single start, which then ran out of steps and so never competed.
-    for (int k = 0; k < options.silhouette_redescents && !r.converged; ++k) {
-      if (!r.left_start && !r.stopped_at_iteration_limit) break;
+    for (const bool line_ends_at_middle : {false, true}) {
       ++pick.tried;
-      auto again = refine(r.left_start ? *r.left_start : r.T_board_antenna);
-      if (!again.converged && again.score >= r.score) break;
-      r = std::move(again);
+      auto r = refine(start, line_ends_at_middle);
+      // A descent that left its start's basin still ended near a minimum: descending again from
+      // there, it is kept if it stays put (then it is a minimum like any other, and the score
+      // chooses among them). Few starts sit in the right basin of a narrow panel seen face-on, and
+      // a panel partly hidden by its mast may take more than one such step to settle (1702-1). One
+      // stopped by the iteration limit is continued alike: 2912-2's right basin (turned round) was
+      // reached by a single start, which then ran out of steps and so never competed.
+      for (int k = 0; k < options.silhouette_redescents && !r.converged; ++k) {
+        if (!r.left_start && !r.stopped_at_iteration_limit) break;
+        ++pick.tried;
+        auto again = refine(r.left_start ? *r.left_start : r.T_board_antenna, line_ends_at_middle);
+        if (!again.converged && again.score >= r.score) break;
+        r = std::move(again);
+      }
+      if (r.converged && r.score > options.silhouette_max_score) {
+        r.converged = false;
+        r.warnings.push_back(fmt::format("the outline fits poorly: score {:.2f} (at most {:.2f})", r.score,
+                                         options.silhouette_max_score));
+      }
+      if (r.converged)
+        done.push_back(std::move(r));
+      else if (failed_score > r.score)
+        failed_score = r.score, pick.closest_failure = r.warnings;
     }
-    if (r.converged && r.score > options.silhouette_max_score) {
-      r.converged = false;
-      r.warnings.push_back(
-          fmt::format("the outline fits poorly: score {:.2f} (at most {:.2f})", r.score, options.silhouette_max_score));
-    }
-    if (r.converged)
-      done.push_back(std::move(r));
-    else if (failed_score > r.score)
-      failed_score = r.score, pick.closest_failure = r.warnings;
   }
   if (done.empty()) return pick;
   std::sort(done.begin(), done.end(), [](const auto& a, const auto& b) { return a.score < b.score; });
@@ -272,8 +281,11 @@ SilhouettePick silhouette_search(const model::AntennaModel& model, const Iso3& T
   // wins; about as good, it is a rival.
   Iso3 turned = pick.best->T_board_antenna;
   turned.linear() = turned_round(turned.linear());
-  auto flipped = refine(turned);
-  ++pick.tried;
+  auto flipped = refine(turned, false);
+  if (auto other = refine(turned, true);
+      other.converged && (!flipped.converged || other.score_with_attachments < flipped.score_with_attachments))
+    flipped = std::move(other);
+  pick.tried += 2;
   if (!flipped.converged) {
     flipped = *pick.best;
     flipped.T_board_antenna = turned;
@@ -583,6 +595,20 @@ PointsFit points_fit(const PointCloud& cloud, const registration::KdTree& model,
   return fit;
 }
 
+// The points' best poses (T_antenna_board, global_start.hpp's hypotheses, best first) whose
+// centre lies more than `apart_m` from the winner's and from each other's, at most `count`.
+std::vector<Iso3> other_positions(const registration::GlobalStartResult& start, double apart_m, std::size_t count) {
+  std::vector<Vec3> centres{start.fit.T_target_source.inverse().translation()};
+  std::vector<Iso3> out;
+  for (const auto& h : start.hypotheses) {
+    if (out.size() >= count) break;
+    const Vec3 c = h.T_model_scene.inverse().translation();
+    if (std::all_of(centres.begin(), centres.end(), [&](const Vec3& d) { return (c - d).norm() > apart_m; }))
+      centres.push_back(c), out.push_back(h.T_model_scene);
+  }
+  return out;
+}
+
 // Which outline searches run: all of them on the first pass; on a second pass, with more objects
 // known in the photos, only the held-axis search (see search_outline for why).
 enum class OutlinePass { kFirst, kHeldAxisOnly };
@@ -660,6 +686,21 @@ OutlineSearch search_outline(const PointCloud& cloud_board, const model::Antenna
     }
     s.with_the_mast.emplace(std::move(with_the_mast));
   }
+  // The points' winner may sit on the mast beside the panel (a rooftop pipe with more points than
+  // a sparse radome: 3201-1, 0.41 m off, no outline start within reach): the points' best poses
+  // started elsewhere are tried in turn, their outline judging them.
+  if (!pick.best && pass == OutlinePass::kFirst)
+    for (const Iso3& T : other_positions(points.start, options.other_position_m, options.other_positions)) {
+      auto other = silhouette_search(model, T.inverse(), site, options);
+      other.tried += pick.tried;
+      if (other.best) {
+        s.with_the_mast.reset();
+        s.held_axis.reset();
+        pick = std::move(other);
+        break;
+      }
+      pick.tried = other.tried;
+    }
   return s;
 }
 

@@ -80,6 +80,11 @@ struct NonContactOptions {
   /// visibility check), so the starts stay within ±90° of it.
   bool silhouette = true;
   std::vector<double> silhouette_yaw_starts_deg = {0, 25, -25, 50, -50, 75, -75};
+  /// Where no outline start converged, the outline search is repeated from the points' best
+  /// poses at other places (registration/global_start.hpp's hypotheses): up to this many, each
+  /// more than other_position_m from the winner's centre and from each other's.
+  std::size_t other_positions = 2;
+  double other_position_m = 0.15;
   double silhouette_rival_margin = 0.02;  // a converged start within this score is a rival
   /// ... or, at another yaw, within this share of the winner's score, if more. Poses 67–79° apart
   /// scored 0.288 and 0.343 (2912-2, the worse one right) and 0.294 and 0.368 (2112-3, the better

@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <tuple>
 
+#include <Eigen/Eigenvalues>
 #include <tbb/parallel_for.h>
 
 namespace antpose::registration {
@@ -25,6 +26,32 @@ Vec3 centroid(const std::vector<Vec3>& points) {
   Vec3 c = Vec3::Zero();
   for (const auto& p : points) c += p;
   return c / static_cast<double>(points.size());
+}
+
+/// Where the model's centre starts (see the header): the centroid, and the centroids of the two
+/// halves split at it across the direction of the points' largest horizontal spread.
+std::vector<Vec3> start_centres(const std::vector<Vec3>& points, const Vec3& up, bool split) {
+  const Vec3 c = centroid(points);
+  if (!split) return {c};
+  Mat3 spread = Mat3::Zero();
+  for (const auto& p : points) {
+    const Vec3 d = (p - c) - (p - c).dot(up) * up;
+    spread += d * d.transpose();
+  }
+  const Vec3 across = Eigen::SelfAdjointEigenSolver<Mat3>(spread).eigenvectors().col(2);
+  std::vector<Vec3> halves{Vec3::Zero(), Vec3::Zero()};
+  std::size_t positive = 0;
+  for (const auto& p : points) {
+    const bool side = (p - c).dot(across) > 0.0;
+    halves[side] += p;
+    positive += side;
+  }
+  std::vector<Vec3> centres{c};
+  if (positive > 0 && positive < points.size()) {
+    centres.push_back(halves[1] / static_cast<double>(positive));
+    centres.push_back(halves[0] / static_cast<double>(points.size() - positive));
+  }
+  return centres;
 }
 
 /// Which points a camera at `viewpoint` sees: those facing it that are nearest in their viewing
@@ -121,7 +148,7 @@ GlobalStartResult global_align(const PreparedCloud& scene, const PreparedCloud& 
   if (!(o.yaw_step_deg > 0.0) || o.downtilt_deg.empty())
     throw std::invalid_argument("global_align: empty hypothesis grid");
   const Mat3 R_scene_upright = rotation_to_up(up_scene.normalized());
-  const Vec3 c_scene = centroid(scene.cloud.points), c_model = centroid(model.cloud.points);
+  const Vec3 c_model = centroid(model.cloud.points);
   const PreparedCloud scene_coarse = prepare(voxel_downsample(scene.cloud, o.coarse_voxel_m), o.coarse);
   const PreparedCloud model_coarse = prepare(voxel_downsample(model.cloud, o.coarse_voxel_m), o.coarse);
   IcpOptions medium = o.coarse;
@@ -129,13 +156,15 @@ GlobalStartResult global_align(const PreparedCloud& scene, const PreparedCloud& 
 
   std::vector<Hypothesis> hypotheses;
   const int yaws = static_cast<int>(std::ceil(360.0 / o.yaw_step_deg - 1e-9));
-  for (double tilt : o.downtilt_deg)
-    for (int k = 0; k < yaws; ++k) {
-      Hypothesis h;
-      h.yaw_rad = deg2rad(k * o.yaw_step_deg);
-      h.downtilt_rad = deg2rad(tilt);
-      hypotheses.push_back(h);
-    }
+  for (const Vec3& centre : start_centres(scene.cloud.points, up_scene.normalized(), o.split_starts))
+    for (double tilt : o.downtilt_deg)
+      for (int k = 0; k < yaws; ++k) {
+        Hypothesis h;
+        h.yaw_rad = deg2rad(k * o.yaw_step_deg);
+        h.downtilt_rad = deg2rad(tilt);
+        h.centre_start_scene = centre;
+        hypotheses.push_back(h);
+      }
   // The hypotheses are independent: refine them in parallel (ICP itself is parallel too; TBB
   // nests the two without oversubscribing).
   tbb::parallel_for(std::size_t{0}, hypotheses.size(), [&](std::size_t i) {
@@ -145,7 +174,7 @@ GlobalStartResult global_align(const PreparedCloud& scene, const PreparedCloud& 
         R_scene_upright * exp_so3(Vec3::UnitZ() * h.yaw_rad) * exp_so3(Vec3::UnitX() * -h.downtilt_rad);
     Iso3 T_model_scene = Iso3::Identity();
     T_model_scene.linear() = R_scene_model.transpose();
-    T_model_scene.translation() = c_model - R_scene_model.transpose() * c_scene;
+    T_model_scene.translation() = c_model - R_scene_model.transpose() * h.centre_start_scene;
     T_model_scene = align(scene_coarse, model_coarse, T_model_scene, o.coarse).T_target_source;
     h.T_model_scene = align(scene_coarse, model_coarse, T_model_scene, medium).T_target_source;
     std::tie(h.residual, h.unseen) = score(scene_coarse, model_coarse, h.T_model_scene, o);

@@ -2,7 +2,11 @@
 // away, and a panel is nearly a symmetric box. So hypotheses are enumerated with a gravity prior:
 // panels hang almost upright (downtilt ≤ ~15°, roll ≤ a few degrees), so the model's long axis
 // z_a is put along the scene's up direction, tilted by each of `downtilt_deg`, and turned about it
-// on a yaw grid. Each hypothesis is refined by ICP on voxel-downsampled clouds (scene → model:
+// on a yaw grid; its centre is put at the scene's centroid and, with `split_starts`, at the
+// centroids of the scene's two halves split there across its largest horizontal spread: a region
+// holding a mast beside the panel (a rooftop pipe 0.4 m away with as many points as the radome)
+// puts the centroid between the two, beyond the coarse ICP's reach of either. Each hypothesis is
+// refined by ICP on voxel-downsampled clouds (scene → model:
 // every scene point has a counterpart on the complete model, not the reverse) and scored; the
 // best one and its best rival facing the other way are then refined on the full clouds.
 //
@@ -28,6 +32,7 @@ struct GlobalStartOptions {
   double yaw_step_deg = 15.0;
   double coarse_voxel_m = 0.02;  // hypothesis search resolution
   std::vector<double> downtilt_deg = {0.0, 10.0};
+  bool split_starts = true;  // centres at the two halves' centroids too (see the file comment)
   IcpOptions coarse = [] {
     IcpOptions o;
     o.method = IcpMethod::kPointToPlane;
@@ -52,6 +57,7 @@ struct GlobalStartOptions {
 
 struct Hypothesis {
   double yaw_rad = 0.0, downtilt_rad = 0.0;  // of the start
+  Vec3 centre_start_scene = Vec3::Zero();     // where the model's centre started
   Iso3 T_model_scene = Iso3::Identity();     // after refinement
   double residual = 0.0, unseen = 0.0;       // the two score parts
   double score() const { return residual + unseen; }

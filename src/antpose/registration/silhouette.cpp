@@ -274,7 +274,8 @@ void gather(const EdgeMesh& m, const Pose& pose, const PreparedView& v, const ca
       // model's own outline, and on a panel narrower than the search range that far side (against
       // the sky, say, where this side is against a grey mast) is often the stronger edge: taken
       // for this side's, or ranking this side's as too weak, it pulls the pose across the panel.
-      const double behind = std::min(search_px, 0.5 * depth_inside(q, normal) * ms / scale);
+      const double behind =
+          o.line_ends_at_middle ? std::min(search_px, 0.5 * depth_inside(q, normal) * ms / scale) : search_px;
       const auto edge =
           camera::nearest_edge(gx, gy, (*p - v.offset) / scale, normal, {behind, search_px}, o.min_edge_gradient, g);
       if (attachment) {

@@ -14,9 +14,10 @@
 // outside: inner shading edges and parts hidden by the brackets are not geometry). Along each
 // sample's normal a 1-D search finds the nearest strong edge (gradient along the normal, a local
 // maximum of its magnitude, ≥ half the strongest on the line; sub-pixel by a parabola; behind the
-// outline the line ends at the projection's middle, short of the model's own far side); the
-// residual is the signed distance. Outline points off the model's box (brackets, whose outline
-// runs into the arms that hold them) are measured for the score with attachments only.
+// outline the line ends at the projection's middle, short of the model's own far side, unless
+// line_ends_at_middle is off); the residual is the signed distance. Outline points off the
+// model's box (brackets, whose outline runs into the arms that hold them) are measured for the
+// score with attachments only.
 // Gauss–Newton with Tukey's biweight (scale from the MAD) solves for the pose, each step's
 // rotation held within a trust region (max_step_rotation_rad: the yaw about the long axis is
 // weakly fixed and a free step can jump basins); silhouettes are re-extracted every iteration. A Gaussian pyramid (cv::pyrDown) runs coarse-to-fine: wide
@@ -74,7 +75,10 @@ struct SilhouetteView {
 };
 
 struct SilhouetteOptions {
-  double search_range_px = 40;        // ± along the normal at the coarsest level (full-resolution px)
+  double search_range_px = 40;  // ± along the normal at the coarsest level (full-resolution px)
+  // Behind the outline the search line ends at the projection's middle, short of the model's own
+  // far side (see the file comment); false: it runs the whole search range.
+  bool line_ends_at_middle = true;
   double fine_search_px = 4;          // ± at every later level (in that level's px)
   double sample_spacing_px = 3;       // along the contour, at full resolution (× 2^level on coarser levels)
   double min_edge_gradient = 3;       // linear grey levels (0–255) / px after smoothing; weaker: no sample
