@@ -687,8 +687,8 @@ OutlineSearch search_outline(const PointCloud& cloud_board, const model::Antenna
     s.with_the_mast.emplace(std::move(with_the_mast));
   }
   // The points' winner may sit on the mast beside the panel (a rooftop pipe with more points than
-  // a sparse radome: 3201-1, 0.41 m off, no outline start within reach): the points' best poses
-  // started elsewhere are tried in turn, their outline judging them.
+  // a sparse radome: 3201-1, 0.41 m off, no outline start within reach): the free search is
+  // repeated from the points' best poses started elsewhere, in turn, their outline judging them.
   if (!pick.best && pass == OutlinePass::kFirst)
     for (const Iso3& T : other_positions(points.start, options.other_position_m, options.other_positions)) {
       auto other = silhouette_search(model, T.inverse(), site, options);

@@ -80,7 +80,7 @@ struct NonContactOptions {
   /// visibility check), so the starts stay within ±90° of it.
   bool silhouette = true;
   std::vector<double> silhouette_yaw_starts_deg = {0, 25, -25, 50, -50, 75, -75};
-  /// Where no outline start converged, the outline search is repeated from the points' best
+  /// Where no outline start converged, the free outline search is repeated from the points' best
   /// poses at other places (registration/global_start.hpp's hypotheses): up to this many, each
   /// more than other_position_m from the winner's centre and from each other's.
   std::size_t other_positions = 2;
