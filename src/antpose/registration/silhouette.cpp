@@ -160,9 +160,11 @@ double edge_cost(std::optional<double> r_px, const SilhouetteOptions& o) {
   return r_px ? std::min(1.0, (*r_px * *r_px) / (o.score_cutoff_px * o.score_cutoff_px)) : 1.0;
 }
 
-// The outer contour samples of one view at `level` with their edge measurements.
+// The outer contour samples of one view at `level` with their edge measurements; the
+// attachments' outline is measured only `with_attachments` (for score_with_attachments, once).
 void gather(const EdgeMesh& m, const Pose& pose, const PreparedView& v, const camera::CameraIntrinsics& K, int level,
-            double search_px, const SilhouetteOptions& o, std::vector<Sample>& out, OutlineCounts& counts) {
+            double search_px, const SilhouetteOptions& o, bool with_attachments, std::vector<Sample>& out,
+            OutlineCounts& counts) {
   counts = {};
   if (!v.usable) return;
   const double scale = std::ldexp(1.0, level);
@@ -238,10 +240,11 @@ void gather(const EdgeMesh& m, const Pose& pose, const PreparedView& v, const ca
     const Vec3& a_antenna = m.vertices[e.a];
     const Vec3& b_antenna = m.vertices[e.b];
     const int n = static_cast<int>(std::floor((pb - pa).norm() / spacing));
-    const Vec3 A = pose.R * m.vertices[e.a] + pose.t, B = pose.R * m.vertices[e.b] + pose.t;
+    const Vec3 A = pose.R * a_antenna + pose.t, B = pose.R * b_antenna + pose.t;
     for (int j = 0; j < n; ++j) {
       const double s = (j + 0.5) / n, ds = 0.25 / n;
       const bool attachment = !on_box(a_antenna + (b_antenna - a_antenna) * s);
+      if (attachment && !with_attachments) continue;
       const Vec3 X = A + (B - A) * s;
       const auto p = project(K, v, X);
       const auto p0 = project(K, v, A + (B - A) * (s - ds));
@@ -319,12 +322,14 @@ struct Gathered {
 };
 
 Gathered gather_all(const EdgeMesh& m, const Pose& pose, const std::vector<PreparedView>& views,
-                    const camera::CameraIntrinsics& K, int level, double search_px, const SilhouetteOptions& o) {
+                    const camera::CameraIntrinsics& K, int level, double search_px, const SilhouetteOptions& o,
+                    bool with_attachments = false) {
   Gathered g;
   g.per_view.resize(views.size());
   std::vector<OutlineCounts> counts(views.size());
   cv::parallel_for_(cv::Range(0, static_cast<int>(views.size())), [&](const cv::Range& r) {
-    for (int i = r.start; i < r.end; ++i) gather(m, pose, views[i], K, level, search_px, o, g.per_view[i], counts[i]);
+    for (int i = r.start; i < r.end; ++i)
+      gather(m, pose, views[i], K, level, search_px, o, with_attachments, g.per_view[i], counts[i]);
   });
   for (std::size_t i = 0; i < views.size(); ++i) {
     g.counts += counts[i];
@@ -617,7 +622,7 @@ SilhouetteResult refine_by_silhouette(const model::Mesh& mesh_antenna, const Iso
   }
 
   // Statistics and covariance at the solution (full resolution, fine search).
-  const Gathered g = gather_all(m, pose, prepared, intrinsics, 0, options.fine_search_px, options);
+  const Gathered g = gather_all(m, pose, prepared, intrinsics, 0, options.fine_search_px, options, true);
   result.score_with_attachments = score(g, options, true);
   Normal n = normal_equations(g, 1.0, options);
   const double prior_weight = n.inliers > 12 ? add_prior(n, pose.R, prior, options) : 0.0;
