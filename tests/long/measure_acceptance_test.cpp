@@ -76,11 +76,21 @@ TEST(MeasureAcceptance, SimulatedSitesThroughTheCommandLine) {
   int failures = 0, disturbed_unflagged_over_3 = 0;
   std::printf("%-4s %-8s %-5s %-3s %9s %9s %9s %9s %9s %9s %8s  %s\n", "cap", "setting", "dist", "ant", "az err°",
               "az σ°", "tilt err°", "tilt σ°", "roll err°", "roll σ°", "fit mm", "warnings");
-  for (int k = 0; k < captures; ++k) {
-    const int seed = seed_base + k;
-    const bool ground = k % 2 == 1;
-    const bool disturbance = k % 3 == 2;
-    const int antennas = 1 + (k / 2) % 3;
+  // The acceptance sites alternate rooftop and ground, with disturbance on every third and 1–3
+  // antennas. The everyday run adds sites where a fault was once found (not counted in the RMS):
+  // 3312 (seeds base 3301, k = 11), whose thesis panel in front of its mast from the ground came
+  // out 3.66° off in downtilt with σ 0.18° (silhouette_tilt_probe_deg).
+  struct Site {
+    int seed;
+    bool ground, disturbance;
+    int antennas;
+    bool regression;
+  };
+  std::vector<Site> sites;
+  for (int k = 0; k < captures; ++k) sites.push_back({seed_base + k, k % 2 == 1, k % 3 == 2, 1 + (k / 2) % 3, false});
+  if (!std::getenv("ANTPOSE_MEASURE_ACCEPTANCE")) sites.push_back({3312, true, true, 3, true});
+  for (std::size_t k = 0; k < sites.size(); ++k) {
+    const auto [seed, ground, disturbance, antennas, regression] = sites[k];
     const std::string name = fmt::format("site-{}", seed);
     run(fmt::format(
         "simulate capture -o {} --scenario antenna --seed {} --device-seed {} --setting {} --antennas {}{} {}",
@@ -108,6 +118,7 @@ TEST(MeasureAcceptance, SimulatedSitesThroughTheCommandLine) {
         EXPECT_FALSE(m["error"].get<std::string>().empty());
         EXPECT_TRUE(m["azimuth_magnetic_deg"].is_null());
         ++failures;
+        EXPECT_FALSE(regression) << "site " << seed << ", antenna " << i << " refused";
         std::printf("%-4d %-8s %-5s %-3zu FAILED: %s\n", seed, ground ? "ground" : "rooftop",
                     disturbance ? "yes" : "no", i, m["error"].get<std::string>().c_str());
         continue;
@@ -125,6 +136,10 @@ TEST(MeasureAcceptance, SimulatedSitesThroughTheCommandLine) {
                   ground ? "ground" : "rooftop", disturbance ? "yes" : "no", i, az, s["azimuth"].get<double>(), tilt,
                   s["downtilt"].get<double>(), roll, s["roll"].get<double>(), 1e3 * m["fit_rmse_m"].get<double>(),
                   warnings.c_str());
+      if (regression) {
+        EXPECT_LE(std::abs(tilt), 0.5) << "site " << seed << ", antenna " << i;
+        continue;
+      }
       const double s_az = s["azimuth"].get<double>(), s_tilt = s["downtilt"].get<double>();
       const double s_roll = s["roll"].get<double>();
       if (disturbance) {

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <sstream>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
@@ -503,8 +504,9 @@ TEST(Silhouette, RejectsBadInput) {
 // the TRUE camera poses and a start perturbed both ways (5° yaw, 2°, 2°, 4.8 cm):
 //   SIL_CAPTURE=/tmp/cap build/tests/antpose_tests --gtest_also_run_disabled_tests
 //     --gtest_filter='Silhouette.DISABLED_SimulatedCapture'
-// Optional: SIL_YAW_DEG, SIL_DT_M (start), SIL_SIGMA, SIL_GAMMA, SIL_SPACING (options), SIL_LOO=1
-// (leave one view out).
+// Optional: SIL_ANTENNA (its index in truth/scene.yaml, default 0), SIL_YAW_DEG, SIL_DT_M or
+// SIL_START (the start: T_board_antenna's rotation by rows, then its translation), SIL_SIGMA,
+// SIL_GAMMA, SIL_SPACING (options), SIL_LOO=1 (leave one view out).
 Mat3 rows(const YAML::Node& n) {
   Mat3 R;
   for (int i = 0; i < 3; ++i)
@@ -526,7 +528,7 @@ TEST(Silhouette, DISABLED_SimulatedCapture) {
   for (int i = 0; i < 5; ++i) K.distortion[i] = dev["distortion"][i].as<double>();
   const Iso3 T_world_board =
       iso(rows(sc["placements"][0]["R_world_board"]), vec(sc["placements"][0]["p_world_board_m"]));
-  const auto& a = sc["antennas"][0];
+  const auto& a = sc["antennas"][std::getenv("SIL_ANTENNA") ? std::atoi(std::getenv("SIL_ANTENNA")) : 0];
   const Iso3 T_true = T_world_board.inverse() * iso(rows(a["R_world_antenna"]), vec(a["p_world_antenna_m"]));
   const auto panel = model::builtin_panel(a["model"].as<std::string>());
   std::vector<SilhouetteView> views;
@@ -558,7 +560,13 @@ TEST(Silhouette, DISABLED_SimulatedCapture) {
   }
   for (int sign : {1, -1}) {
     const double dt = std::getenv("SIL_DT_M") ? std::atof(std::getenv("SIL_DT_M")) : 0.048;
-    const Iso3 start = perturbed(T_true, sign * yaw, sign * 2.0, sign * dt * Vec3(0.03, -0.03, 0.025) / 0.048);
+    Iso3 start = perturbed(T_true, sign * yaw, sign * 2.0, sign * dt * Vec3(0.03, -0.03, 0.025) / 0.048);
+    if (const char* e = std::getenv("SIL_START")) {
+      std::istringstream in(e);
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) in >> start.linear()(i, j);
+      in >> start.translation().x() >> start.translation().y() >> start.translation().z();
+    }
     const auto t0 = std::chrono::steady_clock::now();
     const auto r = refine_by_silhouette(panel.mesh_antenna, start, views, K, o);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
