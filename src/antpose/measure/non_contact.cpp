@@ -215,6 +215,25 @@ SilhouettePick silhouette_search(const model::AntennaModel& model, const Iso3& T
     return held_axis ? refine_holding_axis(model, start, *held_axis, scene, o)
                      : registration::refine_by_silhouette(model.mesh_antenna, start, views, scene.intrinsics, o);
   };
+  // One descent from `start`; where it left its start's basin, or was stopped by the iteration
+  // limit while still moving, descended again from where it ended up to `redescents` times: it
+  // is kept if it stays put (then it is a minimum like any other, and the score chooses among
+  // them). Few starts sit in the right basin of a narrow panel seen face-on, and a panel partly
+  // hidden by its mast may take more than one such step to settle (1702-1); 2912-2's right basin
+  // (turned round) was reached by a single start, which then ran out of steps and so never
+  // competed.
+  const auto descend = [&](const Iso3& start, bool line_ends_at_middle, int redescents) {
+    ++pick.tried;
+    auto r = refine(start, line_ends_at_middle);
+    for (int k = 0; k < redescents && !r.converged; ++k) {
+      if (!r.left_start && !r.stopped_at_iteration_limit) break;
+      ++pick.tried;
+      auto again = refine(r.left_start ? *r.left_start : r.T_board_antenna, line_ends_at_middle);
+      if (!again.converged && again.score >= r.score) break;
+      r = std::move(again);
+    }
+    return r;
+  };
   Vec3 ahead = T_board_antenna.linear().col(1) - T_board_antenna.linear().col(1).dot(up) * up;
   if (ahead.norm() < 1e-6) ahead = up.unitOrthogonal();
   ahead.normalize();
@@ -225,21 +244,7 @@ SilhouettePick silhouette_search(const model::AntennaModel& model, const Iso3& T
     start.linear().col(1) = y;
     start.linear().col(2) = up;
     for (const bool line_ends_at_middle : {false, true}) {
-      ++pick.tried;
-      auto r = refine(start, line_ends_at_middle);
-      // A descent that left its start's basin still ended near a minimum: descending again from
-      // there, it is kept if it stays put (then it is a minimum like any other, and the score
-      // chooses among them). Few starts sit in the right basin of a narrow panel seen face-on, and
-      // a panel partly hidden by its mast may take more than one such step to settle (1702-1). One
-      // stopped by the iteration limit is continued alike: 2912-2's right basin (turned round) was
-      // reached by a single start, which then ran out of steps and so never competed.
-      for (int k = 0; k < options.silhouette_redescents && !r.converged; ++k) {
-        if (!r.left_start && !r.stopped_at_iteration_limit) break;
-        ++pick.tried;
-        auto again = refine(r.left_start ? *r.left_start : r.T_board_antenna, line_ends_at_middle);
-        if (!again.converged && again.score >= r.score) break;
-        r = std::move(again);
-      }
+      auto r = descend(start, line_ends_at_middle, options.silhouette_redescents);
       if (r.converged && r.score > options.silhouette_max_score) {
         r.converged = false;
         r.warnings.push_back(fmt::format("the outline fits poorly: score {:.2f} (at most {:.2f})", r.score,
@@ -269,11 +274,9 @@ SilhouettePick silhouette_search(const model::AntennaModel& model, const Iso3& T
         Iso3 start = winner;
         start.linear() =
             Eigen::AngleAxisd(sign * deg2rad(options.silhouette_tilt_probe_deg), across.normalized()) * winner.linear();
-        for (const bool line_ends_at_middle : {false, true}) {
-          ++pick.tried;
-          auto r = refine(start, line_ends_at_middle);
-          if (r.converged && r.score <= options.silhouette_max_score) done.push_back(std::move(r));
-        }
+        for (const bool line_ends_at_middle : {false, true})
+          if (auto r = descend(start, line_ends_at_middle, 0); r.converged && r.score <= options.silhouette_max_score)
+            done.push_back(std::move(r));
       }
     std::sort(done.begin(), done.end(), by_score);
   }
@@ -306,11 +309,10 @@ SilhouettePick silhouette_search(const model::AntennaModel& model, const Iso3& T
   // wins; about as good, it is a rival.
   Iso3 turned = pick.best->T_board_antenna;
   turned.linear() = turned_round(turned.linear());
-  auto flipped = refine(turned, false);
-  if (auto other = refine(turned, true);
+  auto flipped = descend(turned, false, 0);
+  if (auto other = descend(turned, true, 0);
       other.converged && (!flipped.converged || other.score_with_attachments < flipped.score_with_attachments))
     flipped = std::move(other);
-  pick.tried += 2;
   if (!flipped.converged) {
     flipped = *pick.best;
     flipped.T_board_antenna = turned;
