@@ -97,7 +97,8 @@ struct NonContactOptions {
   /// 1008-1 130° off) 0.466–0.562.
   double silhouette_max_score = 0.4;
   /// A winner scoring above this fits the outline poorly enough that the held-axis search (the
-  /// points' long axis, the mast known) is run too, and wins where it scores lower. The right
+  /// points' long axis, the mast known) is run too, and wins unless the winner, descended again
+  /// with the mast known, scores lower by more than silhouette_rival_margin. The right
   /// poses of 27 development sites scored at most 0.24 but for three antennas partly hidden by
   /// their mast (1612-3, 1712-1: 0.34–0.36), and 2112-3's, 79° off, 0.37.
   double silhouette_doubtful_score = 0.3;
