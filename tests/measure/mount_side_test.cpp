@@ -149,5 +149,36 @@ TEST(MountSide, TheMountDecidesUnlessItWouldTiltThePanelUp) {
   EXPECT_TRUE(against_turned.in_doubt);
 }
 
+// A vertical mast of 0.25 m radius at the origin (frame c: z up), a panel 0.5 m from its axis.
+Iso3 panel_at(double bearing_deg, double boresight_deg) {
+  const double b = deg2rad(bearing_deg), y = deg2rad(boresight_deg);
+  Iso3 T = Iso3::Identity();
+  T.translation() = Vec3(0.5 * std::cos(b), 0.5 * std::sin(b), 3.0);
+  const Vec3 boresight(std::cos(y), std::sin(y), 0.0);
+  T.linear().col(1) = boresight;
+  T.linear().col(2) = Vec3::UnitZ();
+  T.linear().col(0) = boresight.cross(Vec3::UnitZ());
+  return T;
+}
+
+TEST(MountSide, APanelsBackFacesItsMast) {
+  const Vec3 axis_point(0.0, 0.0, 1.0), up = Vec3::UnitZ();
+  const double r = 0.25, limit = deg2rad(60.0);
+  // Facing away from the mast (and up to the limit off it): as registered; towards it: turned.
+  EXPECT_EQ(mast_side_verdict(axis_point, up, r, panel_at(30.0, 30.0), limit), MountVerdict::kAsRegistered);
+  EXPECT_EQ(mast_side_verdict(axis_point, up, r, panel_at(30.0, 80.0), limit), MountVerdict::kAsRegistered);
+  EXPECT_EQ(mast_side_verdict(axis_point, up, r, panel_at(30.0, 210.0), limit), MountVerdict::kTurned);
+  EXPECT_EQ(mast_side_verdict(axis_point, up, r, panel_at(30.0, -160.0), limit), MountVerdict::kTurned);
+  // Side-on to the mast, or its centre within the mast's radius: no verdict.
+  EXPECT_EQ(mast_side_verdict(axis_point, up, r, panel_at(30.0, 120.0), limit), MountVerdict::kUndecided);
+  EXPECT_EQ(mast_side_verdict(axis_point, up, 0.6, panel_at(30.0, 30.0), limit), MountVerdict::kUndecided);
+  // Only the directions across the axis count: a tilted mast, the panel tilted with it.
+  const Mat3 tilt = Eigen::AngleAxisd(deg2rad(10.0), Vec3::UnitX()).toRotationMatrix();
+  Iso3 T = panel_at(30.0, 30.0);
+  T.linear() = tilt * T.linear();
+  T.translation() = tilt * T.translation();
+  EXPECT_EQ(mast_side_verdict(tilt * axis_point, tilt * up, r, T, limit), MountVerdict::kAsRegistered);
+}
+
 }  // namespace
 }  // namespace antpose::measure

@@ -30,6 +30,18 @@ MountVerdict mount_verdict(const MountSide& s, const MountSideOptions& o) {
   return MountVerdict::kUndecided;
 }
 
+MountVerdict mast_side_verdict(const Vec3& axis_point, const Vec3& axis_dir, double radius_m, const Iso3& T_c_antenna,
+                               double max_angle_rad) {
+  const auto across = [&](const Vec3& v) -> Vec3 { return v - v.dot(axis_dir) * axis_dir; };
+  const Vec3 away = across(T_c_antenna.translation() - axis_point);
+  const Vec3 boresight = across(T_c_antenna.linear().col(1));
+  if (away.norm() <= radius_m || boresight.norm() < 1e-9) return MountVerdict::kUndecided;
+  const double cosine = away.normalized().dot(boresight.normalized());
+  if (cosine >= std::cos(max_angle_rad)) return MountVerdict::kAsRegistered;
+  if (cosine <= -std::cos(max_angle_rad)) return MountVerdict::kTurned;
+  return MountVerdict::kUndecided;
+}
+
 double boresight_downtilt(const Mat3& R, const Vec3& up) {
   return -std::asin(std::clamp(R.col(1).dot(up.normalized()), -1.0, 1.0));
 }

@@ -32,6 +32,8 @@ struct MountSideOptions {
   /// wrong ones (1004-1, 1211-1, both turning a right pose into an uptilt) 114 and 80.
   std::size_t min_points_to_turn = 300;
   double ratio = 2.0;
+  /// mast_side_verdict's limit: a panel's boresight this near the direction away from its mast.
+  double mast_max_angle_deg = 60.0;
 };
 
 struct MountSide {
@@ -48,6 +50,17 @@ MountSide count_mount_side(const PointCloud& cloud, const Iso3& T_antenna_cloud,
 enum class MountVerdict { kUndecided, kAsRegistered, kTurned };
 
 MountVerdict mount_verdict(const MountSide& side, const MountSideOptions& options);
+
+/// The mast the panel hangs on, where one was fitted (reconstruction/mast.hpp), as a cue of its
+/// own: a panel's back plate faces its mast. Counted points need not show it: from the ground a
+/// thin panel's radome points scatter 2 cm in depth, beyond its front face as much as its back,
+/// and a thesis panel face-on before its mast had 2.8 times more before it than behind (3502-1).
+/// Across the mast's axis (frame c, `axis_dir_c` unit), the panel's centre lies off the mast by
+/// more than its radius; the boresight y_a within `max_angle_rad` of the direction from the axis
+/// to the centre: as registered; within it of the opposite: turned. Else (the panel beside or
+/// on the mast, or side-on to it) undecided.
+MountVerdict mast_side_verdict(const Vec3& axis_point_c, const Vec3& axis_dir_c, double radius_m,
+                               const Iso3& T_c_antenna, double max_angle_rad);
 
 /// Front and back from both cues. The mount's verdict where it has one. Else the downtilt's sign
 /// (the mast hides behind a panel seen face-on): turned by 180° about its long axis a panel's

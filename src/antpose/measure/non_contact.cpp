@@ -354,10 +354,23 @@ void decide_front_by_mount(AntennaMeasurement& m, SilhouettePick& pick, const mo
     const bool off_axis = rad2deg(angle_between(R.col(2), axis_points)) > options.axis_gate_deg;
     return boresight_downtilt(off_axis ? with_long_axis(R, axis_points) : R, up_board);
   };
+  // The mast, where one was fitted, before the counts (mount_side.hpp: mast_side_verdict).
+  const auto by_mast = [&](const Mat3& R_board_antenna) {
+    if (!m.mast) return MountVerdict::kUndecided;
+    Iso3 T_board_antenna = pick.best->T_board_antenna;
+    T_board_antenna.linear() = R_board_antenna;
+    return mast_side_verdict(m.mast->axis_point_board, m.mast->up_board, m.mast->radius_m, T_board_antenna,
+                             deg2rad(options.mount.mast_max_angle_deg));
+  };
+  const auto verdict = [&](const Mat3& R_board_antenna) {
+    const MountVerdict mast = by_mast(R_board_antenna);
+    return mast != MountVerdict::kUndecided ? mast : mount_verdict(count(R_board_antenna), options.mount);
+  };
   auto side = count(pick.best->T_board_antenna.linear());
   const double tilt = downtilt(pick.best->T_board_antenna.linear());
   const double tilt_turned = pick.turned ? downtilt(pick.turned->T_board_antenna.linear()) : -tilt;
-  const MountVerdict mount = mount_verdict(side, options.mount);
+  const bool mast_decides = by_mast(pick.best->T_board_antenna.linear()) != MountVerdict::kUndecided;
+  const MountVerdict mount = verdict(pick.best->T_board_antenna.linear());
   const FrontBack call = decide_front_back(mount, tilt, tilt_turned, deg2rad(options.max_uptilt_deg));
   const auto turn_round = [&] {
     std::swap(*pick.best, *pick.turned);
@@ -370,6 +383,9 @@ void decide_front_by_mount(AntennaMeasurement& m, SilhouettePick& pick, const mo
             ? fmt::format("front and back decided by the downtilt's sign: as registered the panel would tilt up by "
                           "{:.1f}°; turned round it tilts down by {:.1f}°",
                           -rad2deg(tilt), rad2deg(tilt_turned))
+        : mast_decides
+            ? std::string("the mast decided front and back: as registered the panel faced its mast, so it is turned "
+                          "round (its back plate faces the mast)")
             : fmt::format("the mount decided front and back: {} points beyond the model lay before the panel as "
                           "registered and {} behind it, so the panel is turned round (its brackets and the mast are "
                           "behind it)",
@@ -380,9 +396,11 @@ void decide_front_by_mount(AntennaMeasurement& m, SilhouettePick& pick, const mo
   if (call.in_doubt && pick.turned) {
     const bool mount_turns = mount == MountVerdict::kTurned;
     m.warnings.push_back(fmt::format(
-        "front and back are in doubt: the mount ({} points behind the panel, {} before it) puts the front where the "
-        "panel tilts up by {:.1f}°, and mounts tilt panels down; the σ covers the panel turned round",
-        mount_turns ? side.before : side.behind, mount_turns ? side.behind : side.before,
+        "front and back are in doubt: {} puts the front where the panel tilts up by {:.1f}°, and mounts tilt panels "
+        "down; the σ covers the panel turned round",
+        mast_decides ? std::string("the mast, the back plate facing it,")
+                     : fmt::format("the mount ({} points behind the panel, {} before it)",
+                                   mount_turns ? side.before : side.behind, mount_turns ? side.behind : side.before),
         -rad2deg(mount_turns ? tilt_turned : tilt)));
     if (!mount_turns) turn_round();
     pick.rivals.push_back(pick.turned->T_board_antenna.linear());
@@ -415,8 +433,7 @@ void decide_front_by_mount(AntennaMeasurement& m, SilhouettePick& pick, const mo
       const double angle = boresight_angle_deg(R, R_result);
       if (angle <= options.rival_min_deg || angle >= 180.0 - options.rival_min_deg) continue;
       const Mat3 turned = turned_round(R);
-      const auto own = decide_front_back(mount_verdict(count(R), options.mount), downtilt(R), downtilt(turned),
-                                         deg2rad(options.max_uptilt_deg));
+      const auto own = decide_front_back(verdict(R), downtilt(R), downtilt(turned), deg2rad(options.max_uptilt_deg));
       if (own.verdict == MountVerdict::kTurned || (own.verdict == MountVerdict::kUndecided && angle > 90.0)) R = turned;
     }
   std::erase_if(pick.rivals, [&](const Mat3& R) {
@@ -669,8 +686,8 @@ std::optional<double> score_in(const model::AntennaModel& model, const Iso3& T_b
   for (const bool line_ends_at_middle : {false, true}) {
     auto o = options.silhouette_options;
     o.line_ends_at_middle = line_ends_at_middle;
-    const auto r =
-        registration::refine_by_silhouette(model.mesh_antenna, T_board_antenna, scene.outline_views, scene.intrinsics, o);
+    const auto r = registration::refine_by_silhouette(model.mesh_antenna, T_board_antenna, scene.outline_views,
+                                                      scene.intrinsics, o);
     if (r.converged && (!best || r.score < *best)) best = r.score;
   }
   return best;
@@ -722,11 +739,11 @@ OutlineSearch search_outline(const PointCloud& cloud_board, const model::Antenna
     // scored 0.39 without the mast and 0.085 with it, and the held search's 0.23 (96° off) won.
     // It stands only where it fits clearly better: the held search also knows the points' axis
     // and bounds the yaw by its profile (610-1, 2106-1: 0.011 and 0 apart).
-    std::optional<double> free_score;
+    std::optional<double> free_here;
     if (doubtful && held.best)
-      free_score = score_in(model, pick.best->T_board_antenna, with_the_mast.scene, options).value_or(pick.best->score);
-    if (held.best && (!free_score || held.best->score < *free_score + options.silhouette_rival_margin)) {
-      if (free_score) s.free_score = free_score, s.free_rival_yaw = pick.rival_yaw;
+      free_here = score_in(model, pick.best->T_board_antenna, with_the_mast.scene, options).value_or(pick.best->score);
+    if (held.best && (!free_here || held.best->score < *free_here + options.silhouette_rival_margin)) {
+      if (pick.best) s.free_score = pick.best->score, s.free_rival_yaw = pick.rival_yaw;
       pick = std::move(held);
       s.held_axis = axis;
     } else if (doubtful) {
@@ -816,7 +833,7 @@ OutlineFit fit_outline(AntennaMeasurement& m, const model::AntennaModel& model, 
         !free_score      ? std::string("from no start")
         : free_rival_yaw ? fmt::format("ambiguously (score {:.2f}, and another yaw about as well)", *free_score)
                          : fmt::format("poorly (score {:.2f})", *free_score),
-        free_score ? fmt::format("better ({:.2f}) ", pick.best->score) : std::string(),
+        free_score ? fmt::format("about as well or better ({:.2f}) ", pick.best->score) : std::string(),
         profile.open ? "more than " : "", rad2deg(profile.low_rad), rad2deg(profile.high_rad)));
   }
   m.silhouette_rms_px = pick.best->rms_px;
