@@ -336,8 +336,9 @@ Vec3 points_long_axis(const registration::PreparedCloud& cloud, const registrati
   return axis.dot(T_antenna_board.rotation().row(2).transpose()) < 0.0 ? Vec3(-axis) : axis;
 }
 
-// The mount decides front and back where the outline cannot (mount_side.hpp), and the
-// downtilt's sign where the mount cannot (options.max_uptilt_deg): as registered, the rivals
+// The mount decides front and back where the outline cannot (mount_side.hpp: the mast where one
+// was fitted, else the points counted behind and before the panel), and the downtilt's sign
+// where the mount cannot (options.max_uptilt_deg): as registered, the rivals
 // facing the other way go; turned, the turned pose wins. Where the mount's choice would tilt the
 // panel up beyond that limit the two disagree, and the other way round stays a rival. The
 // downtilt is read with the long axis the measurement keeps (the points' beyond the axis gate).
@@ -363,14 +364,15 @@ void decide_front_by_mount(AntennaMeasurement& m, SilhouettePick& pick, const mo
                              deg2rad(options.mount.mast_max_angle_deg));
   };
   const auto verdict = [&](const Mat3& R_board_antenna) {
-    const MountVerdict mast = by_mast(R_board_antenna);
-    return mast != MountVerdict::kUndecided ? mast : mount_verdict(count(R_board_antenna), options.mount);
+    const MountVerdict cue = by_mast(R_board_antenna);
+    return cue != MountVerdict::kUndecided ? cue : mount_verdict(count(R_board_antenna), options.mount);
   };
   auto side = count(pick.best->T_board_antenna.linear());
   const double tilt = downtilt(pick.best->T_board_antenna.linear());
   const double tilt_turned = pick.turned ? downtilt(pick.turned->T_board_antenna.linear()) : -tilt;
-  const bool mast_decides = by_mast(pick.best->T_board_antenna.linear()) != MountVerdict::kUndecided;
-  const MountVerdict mount = verdict(pick.best->T_board_antenna.linear());
+  const MountVerdict mast = by_mast(pick.best->T_board_antenna.linear());
+  const bool mast_decides = mast != MountVerdict::kUndecided;
+  const MountVerdict mount = mast_decides ? mast : mount_verdict(side, options.mount);
   const FrontBack call = decide_front_back(mount, tilt, tilt_turned, deg2rad(options.max_uptilt_deg));
   const auto turn_round = [&] {
     std::swap(*pick.best, *pick.turned);
