@@ -124,7 +124,6 @@ TEST(MeasureAcceptance, SimulatedSitesThroughTheCommandLine) {
         EXPECT_FALSE(m["error"].get<std::string>().empty());
         EXPECT_TRUE(m["azimuth_magnetic_deg"].is_null());
         ++failures;
-        EXPECT_FALSE(regression) << "site " << seed << ", antenna " << i << " refused";
         std::printf("%-4d %-8s %-5s %-3zu FAILED: %s\n", seed, ground ? "ground" : "rooftop",
                     disturbance ? "yes" : "no", i, m["error"].get<std::string>().c_str());
         continue;
@@ -169,9 +168,9 @@ TEST(MeasureAcceptance, SimulatedSitesThroughTheCommandLine) {
   // The accuracy targets, asserted in the acceptance run (ANTPOSE_MEASURE_ACCEPTANCE=1).
   // The pipeline does not meet them yet on every site (docs/non-contact.md, "Where it stands"),
   // so the everyday run checks what must always hold: every antenna has a number with a finite
-  // σ or a reason (above).
+  // σ (above), and none is refused (site 501's was, its rectangle reaching the roof's edge).
+  EXPECT_EQ(failures, 0);
   if (std::getenv("ANTPOSE_MEASURE_ACCEPTANCE")) {
-    EXPECT_EQ(failures, 0);
     EXPECT_EQ(disturbed_unflagged_over_3, 0);
     EXPECT_LE(clean.rms(clean.sq_az), 1.0);
     EXPECT_LE(clean.rms(clean.sq_tilt), 0.3);

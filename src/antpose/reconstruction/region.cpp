@@ -401,10 +401,21 @@ std::vector<Vec3> statistical_outlier_removal(const std::vector<Vec3>& points, i
 
 }  // namespace
 
-RegionReconstruction reconstruct_region(const std::vector<PosedView>& views, const RefinedPoses& poses,
+namespace {
+
+// The object's surface gave too few points: `range` is the depth range it was sought in.
+class TooFewPoints : public MeasurementError {
+ public:
+  TooFewPoints(const std::string& message, const DepthRange& range) : MeasurementError(message), range(range) {}
+  DepthRange range;
+};
+
+// reconstruct_region, with the object sought among the sparse points more than `beyond_m` from
+// the region's camera (along its axis).
+RegionReconstruction reconstruct_beyond(const std::vector<PosedView>& views, const RefinedPoses& poses,
                                         std::size_t roi_view, const Roi& roi_in,
                                         const camera::CameraIntrinsics& intrinsics, const RegionOptions& options,
-                                        const Progress& progress) {
+                                        const Progress& progress, double beyond_m) {
   const int n = int(views.size());
   if (poses.R_camera_board.size() != views.size() || poses.t_camera_board.size() != views.size())
     throw MeasurementError(fmt::format("{} refined poses for {} photos", poses.R_camera_board.size(), views.size()));
@@ -496,7 +507,10 @@ RegionReconstruction reconstruct_region(const std::vector<PosedView>& views, con
   // Few: a plain radome gives only a handful of features (its corners, brackets); the nearest
   // cluster rule keeps them from being outvoted by the background.
   constexpr std::size_t kMinSparse = 3;
-  const auto range = detail::nearest_depth_cluster(sparse, Rr, tr, kMinSparse);
+  std::vector<Vec3> candidates;
+  for (const Vec3& p : sparse)
+    if ((Rr * p + tr).z() > beyond_m) candidates.push_back(p);
+  const auto range = detail::nearest_depth_cluster(candidates, Rr, tr, kMinSparse);
   if (!range || range->support < kMinSparse)
     throw MeasurementError(fmt::format(
         "no texture or object in the region of {}: only {} feature points could be triangulated there (at least {} "
@@ -628,11 +642,12 @@ RegionReconstruction reconstruct_region(const std::vector<PosedView>& views, con
     return registration::voxel_downsample(d, options.voxel_m).size();
   }();
   if (cloud.size() < options.min_points)
-    throw MeasurementError(fmt::format(
-        "no texture or object in the region of {}: only {} points remain after matching and filtering (at least {} "
-        "are needed); a plain, untextured radome gives too few points — add photos closer to it or draw the region "
-        "tightly around the antenna",
-        ref.name, cloud.size(), options.min_points));
+    throw TooFewPoints(
+        fmt::format("no texture or object in the region of {}: only {} points remain after matching and filtering "
+                    "(at least {} are needed); a plain, untextured radome gives too few points — add photos closer "
+                    "to it or draw the region tightly around the antenna",
+                    ref.name, cloud.size(), options.min_points),
+        *range);
   out.method = dense_voxels >= cloud.size() / 2 ? (sparse_in.empty() ? "dense" : "dense+features") : "features";
   // Coverage: the fraction of cells (≥ 8 × 8 px) inside the convex hull of the points' projections
   // in the reference view (the object's outline, roughly) that hold a point. A plain radome
@@ -686,6 +701,34 @@ RegionReconstruction reconstruct_region(const std::vector<PosedView>& views, con
   out.cloud_board = std::move(cloud);
   out.views_used = std::count(contributed.begin(), contributed.end(), 1);
   return out;
+}
+
+}  // namespace
+
+// The nearest object in the rectangle is the antenna's (detail::nearest_depth_cluster), but an
+// object nearer than the antenna may reach into it: on site 501 (a rooftop panel 6.6 m away) the
+// rectangle's end held the roof's edge 1.4–3.3 m away, whose 18 features made the nearest
+// cluster, and the dense stage found nothing there. Where the nearest object's surface gives too
+// few points, the next object beyond it is reconstructed instead, with a warning.
+RegionReconstruction reconstruct_region(const std::vector<PosedView>& views, const RefinedPoses& poses,
+                                        std::size_t roi_view, const Roi& roi,
+                                        const camera::CameraIntrinsics& intrinsics, const RegionOptions& options,
+                                        const Progress& progress) {
+  try {
+    return reconstruct_beyond(views, poses, roi_view, roi, intrinsics, options, progress, 0.0);
+  } catch (const TooFewPoints& nearest) {
+    try {
+      auto out = reconstruct_beyond(views, poses, roi_view, roi, intrinsics, options, progress, nearest.range.far);
+      out.warnings.insert(out.warnings.begin(),
+                          fmt::format("the nearest object in the region of {}, {:.1f}–{:.1f} m from the camera, gave "
+                                      "too few points for an antenna (the roof's edge, a parapet?): the object beyond "
+                                      "it was reconstructed; check the model drawn over the photos",
+                                      views[roi_view].name, nearest.range.near, nearest.range.far));
+      return out;
+    } catch (const MeasurementError&) {
+      throw MeasurementError(nearest.what());  // the nearest object's reason: nothing beyond it did better
+    }
+  }
 }
 
 }  // namespace antpose::reconstruction
