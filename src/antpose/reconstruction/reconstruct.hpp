@@ -100,7 +100,9 @@ struct RegionReconstruction {
 /// The points of the object inside `roi` of views[roi_view], with the refined poses of
 /// refine_camera_poses (same order as views). MeasurementError when the ROI lies outside the
 /// image, the region is seen in fewer than 2 views, or fewer than options.min_points points
-/// remain (the message says which, e.g. "no texture or object in the region").
+/// remain (the message says which, e.g. "no texture or object in the region"). The object is the
+/// nearest one in the rectangle; where its surface gives too few points (the roof's edge reaching
+/// into the rectangle), the object beyond it, with a warning.
 RegionReconstruction reconstruct_region(const std::vector<PosedView>& views, const RefinedPoses& poses,
                                         std::size_t roi_view, const Roi& roi,
                                         const camera::CameraIntrinsics& intrinsics, const RegionOptions& options,
