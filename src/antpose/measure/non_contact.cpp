@@ -173,6 +173,18 @@ registration::SilhouetteResult refine_holding_axis(const model::AntennaModel& mo
                                             prior);
 }
 
+// One descent of the outline from `start` with the edge search `line_ends_at_middle`
+// (SilhouetteOptions), the long axis free or held to `held_axis` (held_axis_descent's steps).
+registration::SilhouetteResult refine_outline(const model::AntennaModel& model, const Iso3& start, const Scene& scene,
+                                              const NonContactOptions& options, bool line_ends_at_middle,
+                                              const std::optional<Vec3>& held_axis = std::nullopt) {
+  auto o = held_axis ? held_axis_descent(options) : options.silhouette_options;
+  o.line_ends_at_middle = line_ends_at_middle;
+  return held_axis
+             ? refine_holding_axis(model, start, *held_axis, scene, o)
+             : registration::refine_by_silhouette(model.mesh_antenna, start, scene.outline_views, scene.intrinsics, o);
+}
+
 // The silhouette stage: starts turned about the vertical from the points' pose by each start
 // angle, refined by the outline in every photo, the best of them again from tilted along the line
 // of sight; the converged result with the lowest score (the outline's mean truncated edge cost)
@@ -194,7 +206,6 @@ struct SilhouettePick {
 SilhouettePick silhouette_search(const model::AntennaModel& model, const Iso3& T_board_antenna, const Scene& scene,
                                  const NonContactOptions& options,
                                  const std::optional<Vec3>& held_axis = std::nullopt) {
-  const auto& views = scene.outline_views;
   SilhouettePick pick;
   std::vector<registration::SilhouetteResult> done;
   double failed_score = 2.0;
@@ -210,10 +221,7 @@ SilhouettePick silhouette_search(const model::AntennaModel& model, const Iso3& T
   // panel's axis by 9° from upright (1302-1) or to find a thesis panel's outline 15 cm from the
   // points' place (3206-3).
   const auto refine = [&](const Iso3& start, bool line_ends_at_middle) {
-    auto o = held_axis ? held_axis_descent(options) : options.silhouette_options;
-    o.line_ends_at_middle = line_ends_at_middle;
-    return held_axis ? refine_holding_axis(model, start, *held_axis, scene, o)
-                     : registration::refine_by_silhouette(model.mesh_antenna, start, views, scene.intrinsics, o);
+    return refine_outline(model, start, scene, options, line_ends_at_middle, held_axis);
   };
   // One descent from `start`; where it left its start's basin, or was stopped by the iteration
   // limit while still moving, descended again from where it ended up to `redescents` times: it
@@ -685,13 +693,10 @@ PointsRegistration register_points(const PointCloud& cloud_board, const model::A
 std::optional<double> score_in(const model::AntennaModel& model, const Iso3& T_board_antenna, const Scene& scene,
                                const NonContactOptions& options) {
   std::optional<double> best;
-  for (const bool line_ends_at_middle : {false, true}) {
-    auto o = options.silhouette_options;
-    o.line_ends_at_middle = line_ends_at_middle;
-    const auto r = registration::refine_by_silhouette(model.mesh_antenna, T_board_antenna, scene.outline_views,
-                                                      scene.intrinsics, o);
-    if (r.converged && (!best || r.score < *best)) best = r.score;
-  }
+  for (const bool line_ends_at_middle : {false, true})
+    if (const auto r = refine_outline(model, T_board_antenna, scene, options, line_ends_at_middle);
+        r.converged && (!best || r.score < *best))
+      best = r.score;
   return best;
 }
 
