@@ -28,6 +28,7 @@ struct CaptureOptions {
   int antennas = 1;
   bool disturbance = false;
   std::string radome = "weathered";
+  std::optional<double> board_max_distance_m;
   std::string board = "chessboard";
   int jpeg_quality = 92;
   double blur_px = 0.6;
@@ -101,6 +102,7 @@ void run(const CaptureOptions& o) {
   sc.antennas = o.antennas;
   sc.disturbance = o.disturbance;
   sc.radome = radome;
+  sc.board_max_distance_m = o.board_max_distance_m;
   const auto start = std::chrono::steady_clock::now();
   sc.progress = [&](int done, int total) {
     const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -162,6 +164,9 @@ void add_simulate_capture_command(CLI::App& simulate) {
       "antenna: a magnetised steel mast (dipole line) turning magnetic north by 3-8° at the middle of the walk");
   cmd->add_option("--radome", o->radome, "antenna: plain (uniform albedo) or weathered (dirt, streaks, label)")
       ->capture_default_str();
+  cmd->add_option("--board-max-distance", o->board_max_distance_m,
+                  "antenna: the board's greatest distance from the phone along the walk, m, which bounds the walk's "
+                  "span of viewing directions (default 4; 2.5..15)");
   cmd->add_option("--board", o->board, "Board type: chessboard, circles, asymmetric-circles, charuco")
       ->capture_default_str();
   cmd->add_option("--jpeg-quality", o->jpeg_quality, "JPEG quality 1..100")->capture_default_str();

@@ -2,6 +2,9 @@
 // of view, too few ChArUco corners) on images derived from the reference sets.
 #include <cmath>
 #include <map>
+#include <numbers>
+
+#include <Eigen/Dense>
 
 #include <fmt/core.h>
 #include <gmock/gmock.h>
@@ -175,6 +178,59 @@ TEST(BoardDetection, CircleGridsSymmetricAndAsymmetric) {
     EXPECT_FALSE(none.found);
     EXPECT_THAT(none.reason, HasSubstr("no board found"));
   }
+}
+
+// A chessboard 8 m from a 12 MP camera, turned 40° away: 25 px squares, 12 px in the reduced
+// search image. OpenCV's usual 11 px sub-pixel window reaches the neighbouring corners there and
+// moved corners by a whole square (9–14 px); each corner must stay on its own.
+TEST(BoardDetection, ChessboardSeenSmallInALargePhotoKeepsItsCorners) {
+  const BoardSpec board{BoardType::kChessboard, 9, 6, 0.07, 0.0, ""};
+  const double f = 3000.0, turn = 40.0 * std::numbers::pi / 180.0;
+  // Board plane (x, y in metres, origin at the first inner corner) to pixels: H = K [r1 r2 t].
+  const Eigen::Matrix3d K{{f, 0, 2000}, {0, f, 1500}, {0, 0, 1}};
+  const Eigen::Vector3d r1(std::cos(turn), 0, std::sin(turn)), r2(0, 1, 0), t(-0.3, -0.2, 8.0);
+  Eigen::Matrix3d H;
+  H << r1, r2, t;
+  H = K * H;
+  const Eigen::Matrix3d H_inv = H.inverse();
+  const auto to_image = [&](double x, double y) {
+    const Eigen::Vector3d p = H * Eigen::Vector3d(x, y, 1);
+    return Eigen::Vector2d(p.x() / p.z(), p.y() / p.z());
+  };
+  // Each pixel is the mean of 4 × 4 samples: grey ground, a white sheet one square beyond the
+  // pattern, black and white squares.
+  cv::Mat image(3000, 4000, CV_8UC1, cv::Scalar(110));
+  const double s = board.square_m;
+  const Eigen::Vector2d lo = to_image(-2 * s, -2 * s), hi = to_image(9 * s, 6 * s);
+  for (int v = static_cast<int>(std::min(lo.y(), hi.y())) - 30; v < static_cast<int>(std::max(lo.y(), hi.y())) + 30;
+       ++v)
+    for (int u = static_cast<int>(std::min(lo.x(), hi.x())) - 30; u < static_cast<int>(std::max(lo.x(), hi.x())) + 30;
+         ++u) {
+      double sum = 0;
+      for (int i = 0; i < 4; ++i)
+        for (int j = 0; j < 4; ++j) {
+          const Eigen::Vector3d q = H_inv * Eigen::Vector3d(u - 0.375 + 0.25 * j, v - 0.375 + 0.25 * i, 1);
+          const double x = q.x() / q.z() / s + 1, y = q.y() / q.z() / s + 1;  // in squares from the pattern's corner
+          const bool sheet = x > -1 && x < 11 && y > -1 && y < 8;
+          const bool pattern = x > 0 && x < 10 && y > 0 && y < 7;
+          const bool black = pattern && (static_cast<int>(x) + static_cast<int>(y)) % 2 == 0;
+          sum += !sheet ? 110 : black ? 25 : 235;
+        }
+      image.at<std::uint8_t>(v, u) = cv::saturate_cast<std::uint8_t>(sum / 16);
+    }
+  cv::GaussianBlur(image, image, cv::Size(), 0.7);  // a phone's optics
+  const auto d = detect_board(image, board);
+  ASSERT_TRUE(d.found) << d.reason;
+  ASSERT_EQ(d.image_points.size(), 54u);
+  double worst = 0, sum = 0;
+  for (std::size_t i = 0; i < 54; ++i) {
+    const double e = (d.image_points[i] - to_image(d.object_points[i].x(), d.object_points[i].y())).norm();
+    worst = std::max(worst, e);
+    sum += e;
+  }
+  fmt::print("corner error: mean {:.3f} px, largest {:.3f} px\n", sum / 54, worst);
+  EXPECT_LT(sum / 54, 0.1);
+  EXPECT_LT(worst, 0.3);
 }
 
 }  // namespace

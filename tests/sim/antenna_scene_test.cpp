@@ -469,10 +469,30 @@ TEST(SimAntennaCli, WritesAGroundCaptureAndNamesBadOptions) {
   }
   EXPECT_EQ(scene["shots"].size(), 4u);
 
+  // The board's greatest distance from the phone bounds the walk: 4 m by default, or as given
+  // (measured from the board's first corner, within 0.45 m of its centre, which the walk keeps in range).
+  const auto farthest_photo_from_board_m = [](const YAML::Node& t) {
+    const Vec3 board = vec(t["placements"][0]["p_world_board_m"]);
+    double far = 0;
+    for (const auto& shot : t["shots"]) far = std::max(far, (vec(shot["p_world_device_m"]) - board).norm());
+    return far;
+  };
+  const auto wide = test::run_cli("simulate capture -o '" + (dir / "wide").string() +
+                                  "' --scenario antenna --setting ground --photos 4 --width 480 --height 360 "
+                                  "--supersampling 1 --seed 8 --device-seed 3 --board-max-distance 8");
+  ASSERT_EQ(wide.status, 0) << wide.err;
+  const double near = farthest_photo_from_board_m(scene),
+               far = farthest_photo_from_board_m(YAML::LoadFile((dir / "wide/truth/scene.yaml").string()));
+  std::printf("farthest photo from the board: %.2f m by default, %.2f m with --board-max-distance 8\n", near, far);
+  EXPECT_LE(near, 4.0 + 0.45);
+  EXPECT_GT(far, 5.5);
+  EXPECT_LE(far, 8.0 + 0.45);
+
   const std::string o = " -o '" + (dir / "x").string() + "' --scenario antenna";
   const std::vector<std::pair<std::string, std::string>> cases = {
-      {"--setting moon", "--setting"}, {"--antennas 4", "--antennas"}, {"--antennas 0", "--antennas"},
-      {"--radome shiny", "--radome"},  {"--photos 61", "--photos"},
+      {"--setting moon", "--setting"}, {"--antennas 4", "--antennas"},
+      {"--antennas 0", "--antennas"},  {"--radome shiny", "--radome"},
+      {"--photos 61", "--photos"},     {"--board-max-distance 1", "--board-max-distance"},
   };
   for (const auto& [args, name] : cases) {
     const auto e = test::run_cli("simulate capture" + o + " " + args);

@@ -32,7 +32,8 @@ struct DetectionOptions {
   bool fast_check = false;
   bool filter_quads = false;
   // cv::cornerSubPix: half-size of the search window (OpenCV's winSize, (11,11) in OpenCV's
-  // samples), stop after this many iterations or when a corner moves less than epsilon px.
+  // samples), stop after this many iterations or when a corner moves less than epsilon px. On a
+  // chessboard seen small the window shrinks below 0.6 of the corners' spacing (board_detection.cpp).
   int subpix_window = 11;
   int subpix_iterations = 30;
   double subpix_epsilon = 0.001;

@@ -488,6 +488,10 @@ SimulatedCapture simulate_capture(const CaptureScenario& sc, const fs::path& scr
     throw InputError("--antennas", fmt::format("{} is outside 1..3", sc.antennas));
   if (antenna && sc.photos > 60)
     throw InputError("--photos", fmt::format("{} is outside 3..60 for the antenna scenario", sc.photos));
+  // Nearer than 2.5 m the walk has no room beside the board; farther than 15 m a 70 mm square is
+  // under 15 px at 12 MP.
+  if (sc.board_max_distance_m && !(*sc.board_max_distance_m >= 2.5 && *sc.board_max_distance_m <= 15.0))
+    throw InputError("--board-max-distance", fmt::format("{} m is outside 2.5..15", *sc.board_max_distance_m));
   SimulatedCapture out;
   out.device = make_device(sc.device, sc.device_seed.value_or(sc.seed));
   const SimulatedDevice& d = out.device;
@@ -552,6 +556,7 @@ SimulatedCapture simulate_capture(const CaptureScenario& sc, const fs::path& scr
     AntennaTruth at;
     at.radome = sc.radome;
     const bool roof = sc.setting == AntennaSetting::kRooftop;
+    const double board_max = sc.board_max_distance_m.value_or(4.0);
     const camera::CameraIntrinsics& K = d.intrinsics;
     const int factor = std::max(1, std::min(K.width, K.height) / 200);
     const PhotoRenderer low(scaled_intrinsics(K, factor), 1);
@@ -569,11 +574,11 @@ SimulatedCapture simulate_capture(const CaptureScenario& sc, const fs::path& scr
       const double hp = uniform(rng, 1.4, 1.7);
       const Vec3 out_dir(std::sin(phi0), std::cos(phi0), 0.0);
       const Vec3 C = D * out_dir + hp * up;
-      const double b = uniform(rng, 2.2, 3.4), lateral = uniform(rng, -0.3, 0.3);
+      const double b = board_max * uniform(rng, 0.55, 0.85), lateral = uniform(rng, -0.3, 0.3);
       const double zb = roof ? uniform(rng, 1.2, 1.6) : uniform(rng, 1.5, 1.9);
       // The board stays within 4 m of the phone, which bounds the walk's half-length to
       // sqrt(4² − b²) (less a margin for the jitter) and so the span at long range (ground).
-      const double s_max = std::sqrt(3.85 * 3.85 - b * b) - 0.35;
+      const double s_max = std::sqrt(std::pow(board_max - 0.15, 2) - b * b) - 0.35;
       const double span_max =
           std::min(2.0 * std::asin(std::min(1.0, s_max / D)), deg2rad(roof ? uniform(rng, 34.0, 40.0) : 26.0));
       const double span_min = deg2rad(roof ? 25.0 : 10.0);
@@ -599,7 +604,7 @@ SimulatedCapture simulate_capture(const CaptureScenario& sc, const fs::path& scr
           const double Dk = D + uniform(rng, -0.3, 0.3), hk = hp + uniform(rng, -0.05, 0.05);  // sequenced draws
           const Vec3 c = Dk * Vec3(std::sin(psi), std::cos(psi), 0.0) + hk * up;
           const double to_board = (c - Bc).norm();
-          fine = to_board >= 1.5 && to_board <= 4.0;
+          fine = to_board >= 1.5 && to_board <= board_max;
           cs.push_back(c);
         }
         if (!fine) continue;

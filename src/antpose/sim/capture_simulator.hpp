@@ -121,6 +121,10 @@ struct CaptureScenario {
   int antennas = 1;                                   // antenna: 1..3
   bool disturbance = false;                           // antenna: magnetised mast (antenna_scene.hpp)
   RadomeLook radome = RadomeLook::kWeathered;         // antenna
+  /// antenna: the board's greatest distance from the phone along the walk, m, which bounds the
+  /// walk's length and so its span of viewing directions; the board stands 0.55–0.85 of it ahead
+  /// of the walk's middle. Default 4 (docs/simulator.md); 2.5..15.
+  std::optional<double> board_max_distance_m;
   Site site{30.26, 120.12, 20.0, "2025-06-01"};
   /// Called after each photo with (photos done, photos in all).
   std::function<void(int, int)> progress;
