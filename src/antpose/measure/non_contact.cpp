@@ -649,16 +649,30 @@ PointsFit points_fit(const PointCloud& cloud, const registration::KdTree& model,
   return fit;
 }
 
-// The points' best poses (T_antenna_board, global_start.hpp's hypotheses, best first) whose
-// centre lies more than `apart_m` from the winner's and from each other's, at most `count`.
-std::vector<Iso3> other_positions(const registration::GlobalStartResult& start, double apart_m, std::size_t count) {
-  std::vector<Vec3> centres{start.fit.T_target_source.inverse().translation()};
+// Other places for the model (T_antenna_board), each centre more than `apart_m` from the
+// winner's and from each other's: the points' best poses (global_start.hpp's hypotheses, best
+// first), at most `count`; then the winner moved by the model's depth along its boresight, both
+// ways. A region's points lie on the radome's front and on the arms and clamps behind the back
+// plate, and the box can rest on either: on 3208-1 (a 2 m panel from the ground, refused) the
+// points' box sat 0.14 m behind the panel, where no outline start reached the panel's basin.
+std::vector<Iso3> other_positions(const registration::GlobalStartResult& start, double depth_m, double apart_m,
+                                  std::size_t count) {
+  const Iso3& winner = start.fit.T_target_source;
+  std::vector<Vec3> centres{winner.inverse().translation()};
   std::vector<Iso3> out;
+  const auto add = [&](const Iso3& T_antenna_board) {
+    const Vec3 c = T_antenna_board.inverse().translation();
+    if (std::none_of(centres.begin(), centres.end(), [&](const Vec3& d) { return (c - d).norm() <= apart_m; }))
+      centres.push_back(c), out.push_back(T_antenna_board);
+  };
   for (const auto& h : start.hypotheses) {
     if (out.size() >= count) break;
-    const Vec3 c = h.T_model_scene.inverse().translation();
-    if (std::all_of(centres.begin(), centres.end(), [&](const Vec3& d) { return (c - d).norm() > apart_m; }))
-      centres.push_back(c), out.push_back(h.T_model_scene);
+    add(h.T_model_scene);
+  }
+  for (const double sign : {1.0, -1.0}) {
+    Iso3 T_board_antenna = winner.inverse();
+    T_board_antenna.translation() += sign * depth_m * T_board_antenna.linear().col(1);
+    add(T_board_antenna.inverse());
   }
   return out;
 }
@@ -766,7 +780,8 @@ OutlineSearch search_outline(const PointCloud& cloud_board, const model::Antenna
   // a sparse radome: 3201-1, 0.41 m off, no outline start within reach): the free search is
   // repeated from the points' best poses started elsewhere, in turn, their outline judging them.
   if (!pick.best && pass == OutlinePass::kFirst)
-    for (const Iso3& T : other_positions(points.start, options.other_position_m, options.other_positions)) {
+    for (const Iso3& T :
+         other_positions(points.start, model.size_m.y(), options.other_position_m, options.other_positions)) {
       auto other = silhouette_search(model, T.inverse(), site, options);
       other.tried += pick.tried;
       if (other.best) {
