@@ -361,6 +361,33 @@ const SyntheticScene& narrow_panel_from_the_ground() {
   return s;
 }
 
+// A search line behind the outline ends at the projection's middle only where it would reach it
+// (SilhouetteOptions::line_ends_at_middle). The rooftop panel 130 px wide never reaches it with
+// the 40 px search: both settings give the same descent, which measure then runs once. 57 px
+// wide, the coarse search reaches the far side and the flag says so.
+TEST(Silhouette, TheEdgeSearchesAgreeWhereNoLineReachesTheMiddle) {
+  SceneSpec near;
+  near.focal_px = 2400;
+  const auto wide = make_scene(near);
+  const Iso3 start = perturbed(wide.T_board_antenna, 5.0, 2.0, Vec3(0.03, -0.03, 0.025));
+  SilhouetteOptions whole, to_middle;
+  whole.line_ends_at_middle = false;
+  to_middle.line_ends_at_middle = true;
+  const auto a = refine_by_silhouette(wide.mesh_antenna, start, wide.views, wide.intrinsics, whole);
+  const auto b = refine_by_silhouette(wide.mesh_antenna, start, wide.views, wide.intrinsics, to_middle);
+  EXPECT_TRUE(a.converged);
+  EXPECT_FALSE(a.search_reached_middle);
+  EXPECT_FALSE(b.search_reached_middle);
+  EXPECT_TRUE(a.T_board_antenna.isApprox(b.T_board_antenna, 0.0));
+  EXPECT_EQ(a.score, b.score);
+  EXPECT_EQ(a.iterations, b.iterations);
+
+  const auto& s = scene();
+  const auto c = refine_by_silhouette(s.mesh_antenna, perturbed(s.T_board_antenna, 5.0, 2.0, Vec3(0.03, -0.03, 0.025)),
+                                      s.views, s.intrinsics, whole);
+  EXPECT_TRUE(c.search_reached_middle);
+}
+
 TEST(Silhouette, ANarrowPanelInFrontOfAWideMastIsNotAConfidentWrongAnswer) {
   const auto& s = narrow_panel_from_the_ground();
   for (const double yaw : {-6.0, 6.0}) {

@@ -214,8 +214,8 @@ SilhouettePick silhouette_search(const model::AntennaModel& model, const Iso3& T
   // is not kept: on a cluttered region it can be the wrong basin for the outline. With a held
   // axis the starts lie on it and every descent keeps it (refine_holding_axis).
   const Vec3 up = held_axis ? held_axis->normalized() : Vec3(scene.up_board.normalized());
-  // Every start descends with both edge searches (SilhouetteOptions::line_ends_at_middle), and
-  // the scores, on the same fine search, choose: on a panel narrower than the search range its
+  // Every start descends with both edge searches (SilhouetteOptions::line_ends_at_middle) where
+  // they differ (descend_both), and the scores, on the same fine search, choose: on a panel narrower than the search range its
   // far side is often the stronger edge and lures the descents across it (2902-1, refused; 610-1,
   // its downtilt 1.4° off), while a line ending at the middle lacks the reach to turn a 2 m
   // panel's axis by 9° from upright (1302-1) or to find a thesis panel's outline 15 cm from the
@@ -230,17 +230,30 @@ SilhouettePick silhouette_search(const model::AntennaModel& model, const Iso3& T
   // hidden by its mast may take more than one such step to settle (1702-1); 2912-2's right basin
   // (turned round) was reached by a single start, which then ran out of steps and so never
   // competed.
+  // Its search_reached_middle covers every refine it made, the ones it discarded too.
   const auto descend = [&](const Iso3& start, bool line_ends_at_middle, int redescents) {
     ++pick.tried;
     auto r = refine(start, line_ends_at_middle);
+    bool reached_middle = r.search_reached_middle;
     for (int k = 0; k < redescents && !r.converged; ++k) {
       if (!r.left_start && !r.stopped_at_iteration_limit) break;
       ++pick.tried;
       auto again = refine(r.left_start ? *r.left_start : r.T_board_antenna, line_ends_at_middle);
+      reached_middle = reached_middle || again.search_reached_middle;
       if (!again.converged && again.score >= r.score) break;
       r = std::move(again);
     }
+    r.search_reached_middle = reached_middle;
     return r;
+  };
+  // The descents from `start` with both edge searches: the one ending its lines at the middle
+  // only where some line of the other reached it; elsewhere (a panel wider than twice the search
+  // range, as on rooftops) the two are the same descent.
+  const auto descend_both = [&](const Iso3& start, int redescents) {
+    std::vector<registration::SilhouetteResult> out;
+    out.push_back(descend(start, false, redescents));
+    if (out.front().search_reached_middle) out.push_back(descend(start, true, redescents));
+    return out;
   };
   Vec3 ahead = T_board_antenna.linear().col(1) - T_board_antenna.linear().col(1).dot(up) * up;
   if (ahead.norm() < 1e-6) ahead = up.unitOrthogonal();
@@ -251,8 +264,7 @@ SilhouettePick silhouette_search(const model::AntennaModel& model, const Iso3& T
     start.linear().col(0) = y.cross(up);
     start.linear().col(1) = y;
     start.linear().col(2) = up;
-    for (const bool line_ends_at_middle : {false, true}) {
-      auto r = descend(start, line_ends_at_middle, options.silhouette_redescents);
+    for (auto& r : descend_both(start, options.silhouette_redescents)) {
       if (r.converged && r.score > options.silhouette_max_score) {
         r.converged = false;
         r.warnings.push_back(fmt::format("the outline fits poorly: score {:.2f} (at most {:.2f})", r.score,
@@ -282,9 +294,8 @@ SilhouettePick silhouette_search(const model::AntennaModel& model, const Iso3& T
         Iso3 start = winner;
         start.linear() =
             Eigen::AngleAxisd(sign * deg2rad(options.silhouette_tilt_probe_deg), across.normalized()) * winner.linear();
-        for (const bool line_ends_at_middle : {false, true})
-          if (auto r = descend(start, line_ends_at_middle, 0); r.converged && r.score <= options.silhouette_max_score)
-            done.push_back(std::move(r));
+        for (auto& r : descend_both(start, 0))
+          if (r.converged && r.score <= options.silhouette_max_score) done.push_back(std::move(r));
       }
     std::sort(done.begin(), done.end(), by_score);
   }
@@ -317,10 +328,11 @@ SilhouettePick silhouette_search(const model::AntennaModel& model, const Iso3& T
   // wins; about as good, it is a rival.
   Iso3 turned = pick.best->T_board_antenna;
   turned.linear() = turned_round(turned.linear());
-  auto flipped = descend(turned, false, 0);
-  if (auto other = descend(turned, true, 0);
-      other.converged && (!flipped.converged || other.score_with_attachments < flipped.score_with_attachments))
-    flipped = std::move(other);
+  auto both = descend_both(turned, 0);
+  auto flipped = std::move(both.front());
+  if (both.size() > 1 && both.back().converged &&
+      (!flipped.converged || both.back().score_with_attachments < flipped.score_with_attachments))
+    flipped = std::move(both.back());
   if (!flipped.converged) {
     flipped = *pick.best;
     flipped.T_board_antenna = turned;
@@ -707,10 +719,11 @@ PointsRegistration register_points(const PointCloud& cloud_board, const model::A
 std::optional<double> score_in(const model::AntennaModel& model, const Iso3& T_board_antenna, const Scene& scene,
                                const NonContactOptions& options) {
   std::optional<double> best;
-  for (const bool line_ends_at_middle : {false, true})
-    if (const auto r = refine_outline(model, T_board_antenna, scene, options, line_ends_at_middle);
-        r.converged && (!best || r.score < *best))
-      best = r.score;
+  for (const bool line_ends_at_middle : {false, true}) {
+    const auto r = refine_outline(model, T_board_antenna, scene, options, line_ends_at_middle);
+    if (r.converged && (!best || r.score < *best)) best = r.score;
+    if (!r.search_reached_middle) break;  // the other edge search is the same descent
+  }
   return best;
 }
 

@@ -148,9 +148,11 @@ std::optional<cv::Rect2d> projected_box(const camera::CameraIntrinsics& K, const
 struct OutlineCounts {
   std::size_t candidates = 0, outside = 0, attachment_candidates = 0;
   double attachment_cost = 0;
+  bool reached_middle = false;  // some search line behind the outline reached the projection's middle
   OutlineCounts& operator+=(const OutlineCounts& c) {
     candidates += c.candidates, outside += c.outside, attachment_candidates += c.attachment_candidates;
     attachment_cost += c.attachment_cost;
+    reached_middle = reached_middle || c.reached_middle;
     return *this;
   }
 };
@@ -277,8 +279,11 @@ void gather(const EdgeMesh& m, const Pose& pose, const PreparedView& v, const ca
       // model's own outline, and on a panel narrower than the search range that far side (against
       // the sky, say, where this side is against a grey mast) is often the stronger edge: taken
       // for this side's, or ranking this side's as too weak, it pulls the pose across the panel.
-      const double behind =
-          o.line_ends_at_middle ? std::min(search_px, 0.5 * depth_inside(q, normal) * ms / scale) : search_px;
+      // (Whether the middle is within reach is noted either way: where it never is, the descent
+      // is the same with line_ends_at_middle on or off.)
+      const double middle = 0.5 * depth_inside(q, normal) * ms / scale;
+      counts.reached_middle = counts.reached_middle || middle < search_px;
+      const double behind = o.line_ends_at_middle ? std::min(search_px, middle) : search_px;
       const auto edge =
           camera::nearest_edge(gx, gy, (*p - v.offset) / scale, normal, {behind, search_px}, o.min_edge_gradient, g);
       if (attachment) {
@@ -523,9 +528,13 @@ SilhouetteResult refine_by_silhouette(const model::Mesh& mesh_antenna, const Iso
     }
   });
 
-  const auto full_score = [&](const Pose& p) {
-    return score(gather_all(m, p, prepared, intrinsics, 0, options.fine_search_px, options), options);
+  bool reached_middle = false;  // by any search line of any evaluation below
+  const auto gather_here = [&](const Pose& p, int level, double search_px, bool with_attachments = false) {
+    Gathered g = gather_all(m, p, prepared, intrinsics, level, search_px, options, with_attachments);
+    reached_middle = reached_middle || g.counts.reached_middle;
+    return g;
   };
+  const auto full_score = [&](const Pose& p) { return score(gather_here(p, 0, options.fine_search_px), options); };
   // Stages (level, search in that level's px): the coarsest searches wide, every later one
   // ±fine_search_px. A monotone descent also ends on a fine stage where the model is too narrow for
   // a pyramid, on the edges the score and the covariance use (a narrow panel's own, not the
@@ -551,7 +560,7 @@ SilhouetteResult refine_by_silhouette(const model::Mesh& mesh_antenna, const Iso
       d.converged = false;
       Vec6 previous_step = Vec6::Zero();
       for (int it = 0; it < options.max_iterations_per_level; ++it) {
-        const Gathered g = gather_all(m, d.pose, prepared, intrinsics, level, search, options);
+        const Gathered g = gather_here(d.pose, level, search);
         Normal n = normal_equations(g, scale, options);
         if (n.inliers < 12) break;
         add_prior(n, d.pose.R, prior, options);
@@ -622,7 +631,8 @@ SilhouetteResult refine_by_silhouette(const model::Mesh& mesh_antenna, const Iso
   }
 
   // Statistics and covariance at the solution (full resolution, fine search).
-  const Gathered g = gather_all(m, pose, prepared, intrinsics, 0, options.fine_search_px, options, true);
+  const Gathered g = gather_here(pose, 0, options.fine_search_px, true);
+  result.search_reached_middle = reached_middle;
   result.score_with_attachments = score(g, options, true);
   Normal n = normal_equations(g, 1.0, options);
   const double prior_weight = n.inliers > 12 ? add_prior(n, pose.R, prior, options) : 0.0;

@@ -152,6 +152,10 @@ struct SilhouetteResult {
   /// (max_iterations_per_level) still moving: not converged, and a search may continue it from
   /// T_board_antenna.
   bool stopped_at_iteration_limit = false;
+  /// Some search line behind the outline reached the model's projection's middle (where
+  /// SilhouetteOptions::line_ends_at_middle ends it), in any evaluation. Where none did, the
+  /// descent and this result are the same with line_ends_at_middle on or off.
+  bool search_reached_middle = false;
   std::vector<std::string> warnings;
 };
 
