@@ -223,11 +223,11 @@ SilhouettePick silhouette_search(const model::AntennaModel& model, const Iso3& T
   // axis the starts lie on it and every descent keeps it (refine_holding_axis).
   const Vec3 up = held_axis ? held_axis->normalized() : Vec3(scene.up_board.normalized());
   // Every start descends with both edge searches (SilhouetteOptions::line_ends_at_middle) where
-  // they differ (descend_both), and the scores, on the same fine search, choose: on a panel narrower than the search range its
-  // far side is often the stronger edge and lures the descents across it (2902-1, refused; 610-1,
-  // its downtilt 1.4° off), while a line ending at the middle lacks the reach to turn a 2 m
-  // panel's axis by 9° from upright (1302-1) or to find a thesis panel's outline 15 cm from the
-  // points' place (3206-3).
+  // they differ (descend_both), and the scores, on the same fine search, choose: on a panel
+  // narrower than the search range its far side is often the stronger edge and lures the descents
+  // across it (2902-1, refused; 610-1, its downtilt 1.4° off), while a line ending at the middle
+  // lacks the reach to turn a 2 m panel's axis by 9° from upright (1302-1) or to find a thesis
+  // panel's outline 15 cm from the points' place (3206-3).
   const auto refine = [&](const Iso3& start, bool line_ends_at_middle, bool polish) {
     return refine_outline(model, start, scene, options, line_ends_at_middle, held_axis, polish);
   };

@@ -576,8 +576,9 @@ SimulatedCapture simulate_capture(const CaptureScenario& sc, const fs::path& scr
       const Vec3 C = D * out_dir + hp * up;
       const double b = board_max * uniform(rng, 0.55, 0.85), lateral = uniform(rng, -0.3, 0.3);
       const double zb = roof ? uniform(rng, 1.2, 1.6) : uniform(rng, 1.5, 1.9);
-      // The board stays within 4 m of the phone, which bounds the walk's half-length to
-      // sqrt(4² − b²) (less a margin for the jitter) and so the span at long range (ground).
+      // The board stays within board_max (4 m by default) of the phone, which bounds the walk's
+      // half-length to sqrt(board_max² − b²) (less a margin for the jitter) and so the span at
+      // long range (ground).
       const double s_max = std::sqrt(std::pow(board_max - 0.15, 2) - b * b) - 0.35;
       const double span_max =
           std::min(2.0 * std::asin(std::min(1.0, s_max / D)), deg2rad(roof ? uniform(rng, 34.0, 40.0) : 26.0));
