@@ -83,7 +83,10 @@ TEST(MeasureAcceptance, SimulatedSitesThroughTheCommandLine) {
   // whose third panel, a third hidden by its mast, came out 70° off in azimuth and 5.0° in downtilt
   // (σ 2.3°): the held-axis search's score, the mast known, was compared with the free search's
   // without it; 3208 (base 3201, k = 7), a 2 m panel from the ground, refused because the points'
-  // box sat 0.14 m behind it, out of every outline start's reach (other_positions).
+  // box sat 0.14 m behind it, out of every outline start's reach (other_positions); 3711 (base
+  // 3701, k = 10), whose thesis panel between two wider ones on a rooftop came out 12.4° off in
+  // azimuth with σ 1.1°: every outline descent left its basin at the coarse levels (the points'
+  // boresight polished, silhouette_search).
   struct Site {
     int seed;
     bool ground, disturbance;
@@ -96,6 +99,7 @@ TEST(MeasureAcceptance, SimulatedSitesThroughTheCommandLine) {
     sites.push_back({3312, true, true, 3, true});
     sites.push_back({3406, true, true, 3, true});
     sites.push_back({3208, true, false, 1, true});
+    sites.push_back({3711, false, false, 3, true});
   }
   for (std::size_t k = 0; k < sites.size(); ++k) {
     const auto [seed, ground, disturbance, antennas, regression] = sites[k];
@@ -145,7 +149,9 @@ TEST(MeasureAcceptance, SimulatedSitesThroughTheCommandLine) {
                   warnings.c_str());
       if (regression) {
         EXPECT_LE(std::abs(tilt), 0.5) << "site " << seed << ", antenna " << i;
-        if (!disturbance) EXPECT_LE(std::abs(az), 2.0) << "site " << seed << ", antenna " << i;
+        if (!disturbance) {
+          EXPECT_LE(std::abs(az), 2.0) << "site " << seed << ", antenna " << i;
+        }
         continue;
       }
       const double s_az = s["azimuth"].get<double>(), s_tilt = s["downtilt"].get<double>();

@@ -77,7 +77,8 @@ struct NonContactOptions {
   /// The outline stage: starts at the points' pose turned about the panel's axis by these
   /// angles, each refined by the silhouette in every photo (registration/silhouette.hpp). A box's
   /// outline is the same turned by 180°: front and back stay the points' decision (their
-  /// visibility check), so the starts stay within ±90° of it.
+  /// visibility check), so the starts stay within ±90° of it. The points' own boresight is also
+  /// polished at full resolution alone (non_contact.cpp, silhouette_search).
   bool silhouette = true;
   std::vector<double> silhouette_yaw_starts_deg = {0, 25, -25, 50, -50, 75, -75};
   /// Where no outline start converged, the free outline search is repeated from the points' best
