@@ -193,6 +193,17 @@ registration::SilhouetteResult refine_outline(const model::AntennaModel& model, 
              : registration::refine_by_silhouette(model.mesh_antenna, start, scene.outline_views, scene.intrinsics, o);
 }
 
+// The descents `descend(line_ends_at_middle)` with both edge searches (SilhouetteOptions): the
+// one ending its lines at the middle only where some line of the other reached it; elsewhere (a
+// panel wider than twice the search range, as on rooftops) the two are the same descent.
+template <typename Descend>
+std::vector<registration::SilhouetteResult> both_edge_searches(Descend&& descend) {
+  std::vector<registration::SilhouetteResult> out;
+  out.push_back(descend(false));
+  if (out.front().search_reached_middle) out.push_back(descend(true));
+  return out;
+}
+
 // The silhouette stage: starts turned about the vertical from the points' pose by each start
 // angle, refined by the outline in every photo, the best of them again from tilted along the line
 // of sight; the converged result with the lowest score (the outline's mean truncated edge cost)
@@ -254,14 +265,9 @@ SilhouettePick silhouette_search(const model::AntennaModel& model, const Iso3& T
     r.search_reached_middle = reached_middle;
     return r;
   };
-  // The descents from `start` with both edge searches: the one ending its lines at the middle
-  // only where some line of the other reached it; elsewhere (a panel wider than twice the search
-  // range, as on rooftops) the two are the same descent.
   const auto descend_both = [&](const Iso3& start, int redescents, bool polish = false) {
-    std::vector<registration::SilhouetteResult> out;
-    out.push_back(descend(start, false, redescents, polish));
-    if (out.front().search_reached_middle) out.push_back(descend(start, true, redescents, polish));
-    return out;
+    return both_edge_searches(
+        [&](bool line_ends_at_middle) { return descend(start, line_ends_at_middle, redescents, polish); });
   };
   Vec3 ahead = T_board_antenna.linear().col(1) - T_board_antenna.linear().col(1).dot(up) * up;
   if (ahead.norm() < 1e-6) ahead = up.unitOrthogonal();
@@ -743,11 +749,10 @@ PointsRegistration register_points(const PointCloud& cloud_board, const model::A
 std::optional<double> score_in(const model::AntennaModel& model, const Iso3& T_board_antenna, const Scene& scene,
                                const NonContactOptions& options) {
   std::optional<double> best;
-  for (const bool line_ends_at_middle : {false, true}) {
-    const auto r = refine_outline(model, T_board_antenna, scene, options, line_ends_at_middle);
+  for (const auto& r : both_edge_searches([&](bool line_ends_at_middle) {
+         return refine_outline(model, T_board_antenna, scene, options, line_ends_at_middle);
+       }))
     if (r.converged && (!best || r.score < *best)) best = r.score;
-    if (!r.search_reached_middle) break;  // the other edge search is the same descent
-  }
   return best;
 }
 
