@@ -694,10 +694,15 @@ PointsFit points_fit(const PointCloud& cloud, const registration::KdTree& model,
 // Other places for the model (T_antenna_board), each centre more than `apart_m` from the
 // winner's and from each other's: the points' best poses (global_start.hpp's hypotheses, best
 // first), at most `count`; then the winner moved by the model's depth along its boresight, both
-// ways. A region's points lie on the radome's front and on the arms and clamps behind the back
-// plate, and the box can rest on either: on 3208-1 (a 2 m panel from the ground, refused) the
-// points' box sat 0.14 m behind the panel, where no outline start reached the panel's basin.
-std::vector<Iso3> other_positions(const registration::GlobalStartResult& start, double depth_m, double apart_m,
+// ways; last the winner slid along its long axis by 1/16 and 1/8 of the model's length, both
+// ways (nearer than `apart_m`: the outline's basin along the axis is narrow). A region's points
+// lie on the radome's front and on the arms and clamps behind the back plate, and the box can
+// rest on either: on 3208-1 (a 2 m panel from the ground, refused) the points' box sat 0.14 m
+// behind the panel, where no outline start reached the panel's basin. Where other panels hide
+// part of it, the points fix the box's position along its axis poorly: on 3811-3 (a 2 m panel
+// behind two thesis panels on a rooftop, refused) it sat 0.12 m along the axis from the panel,
+// and every start from there failed, where the same starts at the panel's centre converged.
+std::vector<Iso3> other_positions(const registration::GlobalStartResult& start, const Vec3& size_m, double apart_m,
                                   std::size_t count) {
   const Iso3& winner = start.fit.T_target_source;
   std::vector<Vec3> centres{winner.inverse().translation()};
@@ -711,11 +716,13 @@ std::vector<Iso3> other_positions(const registration::GlobalStartResult& start, 
     if (out.size() >= count) break;
     add(h.T_model_scene);
   }
-  for (const double sign : {1.0, -1.0}) {
+  const auto moved = [&](double distance_m, int axis) {
     Iso3 T_board_antenna = winner.inverse();
-    T_board_antenna.translation() += sign * depth_m * T_board_antenna.linear().col(1);
-    add(T_board_antenna.inverse());
-  }
+    T_board_antenna.translation() += distance_m * T_board_antenna.linear().col(axis);
+    return T_board_antenna.inverse();
+  };
+  for (const double sign : {1.0, -1.0}) add(moved(sign * size_m.y(), 1));
+  for (const double share : {1.0 / 16, -1.0 / 16, 1.0 / 8, -1.0 / 8}) out.push_back(moved(share * size_m.z(), 2));
   return out;
 }
 
@@ -823,7 +830,7 @@ OutlineSearch search_outline(const PointCloud& cloud_board, const model::Antenna
   // repeated from the points' best poses started elsewhere, in turn, their outline judging them.
   if (!pick.best && pass == OutlinePass::kFirst)
     for (const Iso3& T :
-         other_positions(points.start, model.size_m.y(), options.other_position_m, options.other_positions)) {
+         other_positions(points.start, model.size_m, options.other_position_m, options.other_positions)) {
       auto other = silhouette_search(model, T.inverse(), site, options);
       other.tried += pick.tried;
       if (other.best) {
