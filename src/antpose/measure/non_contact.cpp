@@ -294,6 +294,10 @@ SilhouettePick silhouette_search(const model::AntennaModel& model, const Iso3& T
     }
   }
   if (done.empty()) return pick;
+  // The later descents (polish, tilt probe) join the starts' converged ones where they fit as well.
+  const auto keep_if_fits = [&](registration::SilhouetteResult& r) {
+    if (r.converged && r.score <= options.silhouette_max_score) done.push_back(std::move(r));
+  };
   // The start at the points' own boresight is also polished where it stands: the coarse levels'
   // wide search can leave a narrow panel's basin for a worse one at full resolution. On 3711-2
   // (a thesis panel between two wider ones on a rooftop, its outline crossing theirs) every
@@ -301,8 +305,7 @@ SilhouettePick silhouette_search(const model::AntennaModel& model, const Iso3& T
   // competes only where a descent converged: alone, it settles on whatever edges lie within its
   // ±4 px, and it won confidently wrong where the held-axis search was needed (1304-2, 45° off
   // with σ 1.6°; 604-1 and 1706-2).
-  for (auto& r : descend_both(upright_at(0.0), 0, true))
-    if (r.converged && r.score <= options.silhouette_max_score) done.push_back(std::move(r));
+  for (auto& r : descend_both(upright_at(0.0), 0, true)) keep_if_fits(r);
   const auto by_score = [](const auto& a, const auto& b) { return a.score < b.score; };
   std::sort(done.begin(), done.end(), by_score);
   // Seen from below, a downtilt tilts the panel's axis along the line of sight, which hardly moves
@@ -320,8 +323,7 @@ SilhouettePick silhouette_search(const model::AntennaModel& model, const Iso3& T
         Iso3 start = winner;
         start.linear() =
             Eigen::AngleAxisd(sign * deg2rad(options.silhouette_tilt_probe_deg), across.normalized()) * winner.linear();
-        for (auto& r : descend_both(start, 0))
-          if (r.converged && r.score <= options.silhouette_max_score) done.push_back(std::move(r));
+        for (auto& r : descend_both(start, 0)) keep_if_fits(r);
       }
     std::sort(done.begin(), done.end(), by_score);
   }
