@@ -6,6 +6,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "antpose/calibration/accelerometer.hpp"
+#include "antpose/imu/imu_calibration.hpp"
 #include "antpose/sim/imu_simulator.hpp"
 #include "support/test_support.hpp"
 
@@ -116,6 +118,66 @@ TEST(MagnetometerCalibration, TooFewSamples) {
     FAIL();
   } catch (const MeasurementError& e) {
     EXPECT_THAT(e.what(), HasSubstr("3 samples, need at least 50"));
+  }
+}
+
+// A typical phone tumbled: its accelerometer's mounting rotation Q defines the calibrated frame
+// (x along the accelerometer's x axis), which the magnetometer, in the device's own axes, does
+// not share. Both sensors corrected with the simulator's own calibrations, the dot-product fit
+// recovers R_calibrated_magnetometer = Qᵀ (0.1–0.2° per axis) to its σ, and the field's dip.
+TEST(MagnetometerAlignment, RecoversTheAccelerometersMountingFromATumble) {
+  sim::ImuSimulation sim;
+  sim.phone = sim::PhoneModel::typical();
+  sim.trajectory = sim::tumble(30.0, 1.0, 4);
+  sim.seed = 11;
+  Capture capture = sim::simulate_imu(sim);
+  const auto& a = sim.phone.accelerometer;
+  const auto& m = sim.phone.magnetometer;
+  imu::ImuCalibration truth;
+  Mat3 Q;
+  canonical_accelerometer((a.misalignment * a.scale.asDiagonal()).inverse(), truth.acc_misalignment, truth.acc_scale,
+                          &Q);
+  truth.acc_bias = a.bias;
+  truth.mag_hard_iron_uT = m.hard_iron_uT;
+  truth.mag_soft_iron = m.soft_iron.inverse();
+  imu::apply(truth, capture);
+  const auto r = fit_magnetometer_alignment(capture.require(streams::kAccelerometer),
+                                            capture.require(streams::kMagnetometer), sim.gravity, {}, "tumble");
+  const Vec3 truth_turn = log_so3(Q.transpose()), error = log_so3(r.R_calibrated_magnetometer * Q);
+  const double dip = std::atan2(-sim.field_world_uT.z(), sim.field_world_uT.head<2>().norm());
+  std::printf(
+      "alignment: truth (%.3f, %.3f, %.3f)°, error (%.3f, %.3f, %.3f)°, 1σ (%.3f, %.3f, %.3f)°, dip error %.4f°, "
+      "%zu samples\n",
+      rad2deg(truth_turn.x()), rad2deg(truth_turn.y()), rad2deg(truth_turn.z()), rad2deg(error.x()), rad2deg(error.y()),
+      rad2deg(error.z()), rad2deg(r.sigma_rad.x()), rad2deg(r.sigma_rad.y()), rad2deg(r.sigma_rad.z()),
+      rad2deg(r.dip_rad - dip), r.samples);
+  EXPECT_GT(truth_turn.norm(), deg2rad(0.1));  // there is something to find
+  for (int i = 0; i < 3; ++i) EXPECT_LT(std::abs(error(i)), 4.0 * r.sigma_rad(i) + deg2rad(0.01)) << i;
+  EXPECT_LT(r.sigma_rad.maxCoeff(), deg2rad(0.05));
+  EXPECT_NEAR(rad2deg(r.dip_rad), rad2deg(dip), 0.05);
+
+  // The same phone only turned about its screen's normal: gravity from one direction.
+  sim::ImuSimulation flat = sim;
+  std::vector<Mat3> poses;
+  for (int k = 0; k < 12; ++k) poses.push_back(rot_z(k * M_PI / 6));
+  flat.trajectory = sim::static_poses(poses, 1.0, 1.0);
+  Capture flat_capture = sim::simulate_imu(flat);
+  imu::apply(truth, flat_capture);
+  try {
+    fit_magnetometer_alignment(flat_capture.require(streams::kAccelerometer),
+                               flat_capture.require(streams::kMagnetometer), sim.gravity, {}, "flat");
+    FAIL() << "accepted gravity from one direction";
+  } catch (const MeasurementError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("flat: magnetometer alignment: gravity was seen from too few directions"));
+  }
+  // Accelerations everywhere (a phone shaken, not turned): nothing at rest-like acceleration.
+  Stream shaken = capture.require(streams::kAccelerometer);
+  shaken.values *= 1.2;
+  try {
+    fit_magnetometer_alignment(shaken, capture.require(streams::kMagnetometer), sim.gravity, {}, "shaken");
+    FAIL() << "accepted accelerations of 0.2 g";
+  } catch (const MeasurementError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("shaken: magnetometer alignment: 0 samples at rest-like acceleration"));
   }
 }
 

@@ -3,6 +3,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "antpose/geometry/rotation.hpp"
 #include "antpose/io/text_file.hpp"
 #include "support/test_support.hpp"
 
@@ -16,6 +17,7 @@ TEST(ImuCalibration, RoundTripKeepsValuesAndUnknownKeys) {
   ImuCalibration c;
   c.mag_hard_iron_uT = Vec3(12.5, -3.25, 40.0000001);
   c.mag_soft_iron << 1.01, 0.02, 0.0, 0.02, 0.98, -0.01, 0.0, -0.01, 1.03;
+  c.mag_alignment = exp_so3(deg2rad(1.0) * Vec3(0.17, 0.12, -0.06));
   c.acc_bias = Vec3(0.05, -0.1, 0.2);
   c.acc_scale = Vec3(1.001, 0.999, 1.0);
   c.gyro_bias = Vec3(1e-3, -2e-3, 3e-3);
@@ -28,6 +30,7 @@ TEST(ImuCalibration, RoundTripKeepsValuesAndUnknownKeys) {
   const ImuCalibration r = read_imu_calibration(dir / "phone.yaml");
   EXPECT_EQ(r.mag_hard_iron_uT, c.mag_hard_iron_uT);
   EXPECT_EQ(r.mag_soft_iron, c.mag_soft_iron);
+  EXPECT_LT((r.mag_alignment - c.mag_alignment).cwiseAbs().maxCoeff(), 1e-15);
   EXPECT_EQ(r.acc_bias, c.acc_bias);
   EXPECT_EQ(r.acc_scale, c.acc_scale);
   EXPECT_EQ(r.gyro_bias, c.gyro_bias);
@@ -40,6 +43,7 @@ TEST(ImuCalibration, MissingEntriesAreNeutral) {
                                        "x.yaml");
   EXPECT_EQ(c.mag_hard_iron_uT, Vec3(1, 2, 3));
   EXPECT_EQ(c.mag_soft_iron, Mat3::Identity());
+  EXPECT_EQ(c.mag_alignment, Mat3::Identity());
   EXPECT_EQ(c.acc_scale, Vec3::Ones());
   EXPECT_EQ(c.gyro_bias, Vec3::Zero());
 }
@@ -67,7 +71,8 @@ TEST_P(ImuCalibrationBad, NamesFileLineAndExpectation) {
 INSTANTIATE_TEST_SUITE_P(
     Cases, ImuCalibrationBad,
     ::testing::Values(
-        BadFile{"format: antpose-capture\nversion: 1\nimu: {}\n", "bad.yaml:1: format is 'antpose-capture', expected 'antpose-device'"},
+        BadFile{"format: antpose-capture\nversion: 1\nimu: {}\n",
+                "bad.yaml:1: format is 'antpose-capture', expected 'antpose-device'"},
         BadFile{"version: 1\n", "no 'format' key"},
         BadFile{"format: antpose-device\nversion: 7\nimu: {}\n", "bad.yaml:2: format version 7 is not supported"},
         BadFile{"format: antpose-device\nversion: 1\n", "no 'imu' section"},
@@ -77,11 +82,19 @@ INSTANTIATE_TEST_SUITE_P(
                 "bad.yaml:6: imu.accelerometer.bias_m_s2[1]: 'abc' is not a number"},
         BadFile{"format: antpose-device\nversion: 1\nimu:\n  magnetometer:\n    soft_iron: [[0,0,0],[0,1,0],[0,0,1]]\n",
                 "bad.yaml:5: imu.magnetometer.soft_iron has determinant 0"},
+        BadFile{
+            "format: antpose-device\nversion: 1\nimu:\n  magnetometer:\n    alignment: [[1,0,0],[0,1,0],[0,0,-1]]\n",
+            "bad.yaml:5: imu.magnetometer.alignment is not a small rotation (RᵀR − I off by 0, determinant -1.000, "
+            "angle 90.0°); expected a rotation within 10° of the identity"},
+        BadFile{
+            "format: antpose-device\nversion: 1\nimu:\n  magnetometer:\n    alignment: [[1,0.1,0],[0,1,0],[0,0,1]]\n",
+            "imu.magnetometer.alignment is not a small rotation (RᵀR − I off by 0.14"},
         BadFile{"format: antpose-device\nversion: 1\nimu:\n  magnetometer:\n    hard_iron_uT: [20000, 0, 0]\n",
                 "was it written in nT?"},
         BadFile{"format: antpose-device\nversion: 1\nimu:\n  accelerometer:\n    scale: [9.81, 1, 1]\n",
                 "expected factors between 0.5 and 2"},
-        BadFile{"format: antpose-device\nversion: 1\nimu: [1, 2]\n", "bad.yaml:3: 'imu' is a list of 2, expected a map"},
+        BadFile{"format: antpose-device\nversion: 1\nimu: [1, 2]\n",
+                "bad.yaml:3: 'imu' is a list of 2, expected a map"},
         BadFile{"format: antpose-device\nversion: 1\nimu: {magnetometer: [\n", "not valid YAML"}));
 
 TEST(ImuCalibration, MissingFile) {
@@ -100,8 +113,9 @@ TEST(ImuCalibration, ApplyCorrectsTheStreams) {
   cal.acc_bias = Vec3(0, 0, 0.2);
   cal.acc_scale = Vec3(1, 1, 1.0 / 0.98);
   cal.gyro_bias = Vec3(0.1, 0.1, 0.1);
+  cal.mag_alignment = rot_z(M_PI / 2);  // after the soft iron: (20, 20, 15) turned to (−20, 20, 15)
   apply(cal, c);
-  EXPECT_TRUE(c.streams["magnetometer"].xyz(0).isApprox(Vec3(20, 20, 15)));
+  EXPECT_TRUE(c.streams["magnetometer"].xyz(0).isApprox(Vec3(-20, 20, 15)));
   EXPECT_TRUE(c.streams["accelerometer"].xyz(0).isApprox(Vec3(1, 2, 10)));
   EXPECT_TRUE(c.streams["gyroscope"].xyz(0).isApprox(Vec3(0, 0.1, 0.2)));
 }

@@ -94,6 +94,27 @@ CalibrateImuResult calibrate_imu(const Capture& capture, const CalibrateImuOptio
       cal.mag_soft_iron = r.magnetometer->soft_iron;
       cal.mag_field_uT = r.magnetometer->field_uT;
       cal.mag_residual_rel = r.magnetometer->residual_rel;
+      cal.mag_alignment = Mat3::Identity();
+      if (!cal.acc_residual_rms_m_s2 || !capture.streams.count(std::string(streams::kAccelerometer))) {
+        diagnostics.warn(source, 0,
+                         "the magnetometer's axes were not aligned to the accelerometer's (no accelerometer "
+                         "calibration yet): calibrate the accelerometer first, then the magnetometer, or the compass "
+                         "may be off by tenths of a degree");
+      } else {
+        // The accelerometer and the field as calibrated so far, then the field's axes turned onto the
+        // accelerometer's.
+        Capture corrected = capture;
+        imu::apply(cal, corrected);
+        try {
+          r.magnetometer_alignment = fit_magnetometer_alignment(corrected.require(streams::kAccelerometer),
+                                                                corrected.require(streams::kMagnetometer), r.gravity,
+                                                                o.magnetometer_alignment_options, source);
+          cal.mag_alignment = r.magnetometer_alignment->R_calibrated_magnetometer;
+        } catch (const MeasurementError& e) {
+          diagnostics.warn(source, 0,
+                           fmt::format("{}; the magnetometer's axes are taken as the accelerometer's", e.what()));
+        }
+      }
     } else {
       r.hard_iron = imu::estimate_hard_iron(mag, {}, source);
       cal.mag_hard_iron_uT = r.hard_iron->hard_iron_uT;
@@ -189,6 +210,14 @@ std::string describe(const CalibrateImuResult& r) {
     s += fmt::format("  field strength {:.3f} µT, ellipsoid semi-axes {} µT\n", m.field_uT, vec(m.semi_axes_uT, 2));
     s += fmt::format("  soft iron [{}; {}; {}]\n", vec(m.soft_iron.row(0).transpose()), vec(m.soft_iron.row(1).transpose()),
                      vec(m.soft_iron.row(2).transpose()));
+  }
+  if (r.magnetometer_alignment) {
+    const auto& a = *r.magnetometer_alignment;
+    const Eigen::AngleAxisd turn(a.R_calibrated_magnetometer);
+    s += fmt::format("magnetometer axes onto the accelerometer's ({} samples at rest-like acceleration)\n", a.samples);
+    s += fmt::format("  rotation {} ° (1σ {} °), dip {:.3f}°, angle residual RMS {:.3f}°\n",
+                     vec(deg(turn.angle()) * turn.axis(), 4), vec(a.sigma_rad * 180.0 / M_PI, 4), deg(a.dip_rad),
+                     deg(a.residual_rms_rad));
   }
   if (r.hard_iron) {
     const auto& h = *r.hard_iron;

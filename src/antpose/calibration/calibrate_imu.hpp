@@ -36,6 +36,7 @@ struct CalibrateImuOptions {
   StaticFrameOptions frames{};
   GyroscopeOptions gyroscope_options{};
   MagnetometerOptions magnetometer_options{};
+  MagnetometerAlignmentOptions magnetometer_alignment_options{};
 };
 
 /// Parses "acc,gyro,mag" (any subset, also accelerometer/gyroscope/magnetometer) into the three
@@ -50,6 +51,7 @@ struct CalibrateImuResult {
   std::optional<AccelerometerCalibration> accelerometer;  // the one used (thesis or full)
   std::optional<GyroscopeCalibration> gyroscope;
   std::optional<MagnetometerCalibration> magnetometer;   // method full
+  std::optional<MagnetometerAlignment> magnetometer_alignment;  // method full, the accelerometer calibrated
   std::optional<imu::HardIronEstimate> hard_iron;         // method thesis
   bool wrote_accelerometer = false, wrote_gyroscope = false, wrote_magnetometer = false;
 };

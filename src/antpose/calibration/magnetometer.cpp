@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include <ceres/ceres.h>
+#include <ceres/rotation.h>
 #include <Eigen/Dense>
 #include <fmt/format.h>
 
@@ -45,6 +46,20 @@ struct EllipsoidResidual {
 };
 
 // Index of the nearest of the 26 directions (±1, 0)³ \ 0.
+// â · R m̂ − c, R = exp(w).
+struct DotProductResidual {
+  DotProductResidual(const Vec3& up, const Vec3& field) : up_(up), field_(field) {}
+  template <typename T>
+  bool operator()(const T* const w, const T* const c, T* r) const {
+    const T m[3] = {T(field_.x()), T(field_.y()), T(field_.z())};
+    T Rm[3];
+    ceres::AngleAxisRotatePoint(w, m, Rm);
+    r[0] = T(up_.x()) * Rm[0] + T(up_.y()) * Rm[1] + T(up_.z()) * Rm[2] - c[0];
+    return true;
+  }
+  Vec3 up_, field_;
+};
+
 int direction_bin(const Vec3& u) {
   int best = 0, idx = 0;
   double best_dot = -2.0;
@@ -179,6 +194,73 @@ MagnetometerCalibration fit_magnetometer(const Stream& stream, const Magnetomete
   c.residual_rel = sd_c / c.field_uT;
   (void)mean_c;
   return c;
+}
+
+MagnetometerAlignment fit_magnetometer_alignment(const Stream& accelerometer, const Stream& magnetometer,
+                                                 double gravity, const MagnetometerAlignmentOptions& o,
+                                                 const std::filesystem::path& source) {
+  // Pairs (â, m̂) at the magnetometer's instants where the accelerometer feels gravity alone.
+  std::vector<Vec3> up, field;
+  Mat3 spread = Mat3::Zero();
+  std::size_t k = 0;
+  const auto& ta = accelerometer.t;
+  for (std::size_t i = 0; i < magnetometer.size() && ta.size() > 1; ++i) {
+    const double t = magnetometer.t[i];
+    while (k + 2 < ta.size() && ta[k + 1] <= t) ++k;
+    if (t < ta[k] || t > ta[k + 1]) continue;
+    const double u = (t - ta[k]) / (ta[k + 1] - ta[k]);
+    const Vec3 a = (1.0 - u) * accelerometer.xyz(k) + u * accelerometer.xyz(k + 1);
+    const Vec3 m = magnetometer.xyz(i);
+    if (!a.allFinite() || !m.allFinite() || !(m.norm() > 0.0)) continue;
+    if (std::abs(a.norm() - gravity) > o.static_tolerance * gravity) continue;
+    up.push_back(a.normalized());
+    field.push_back(m.normalized());
+    spread += up.back() * up.back().transpose();
+  }
+  MagnetometerAlignment out;
+  out.samples = up.size();
+  if (up.size() < o.min_samples)
+    throw MeasurementError(prefix(source) + fmt::format("magnetometer alignment: {} samples at rest-like acceleration "
+                                                        "(within {:.0f} % of g), need at least {}",
+                                                        up.size(), 100 * o.static_tolerance, o.min_samples));
+  out.spread = Eigen::SelfAdjointEigenSolver<Mat3>(spread / static_cast<double>(up.size())).eigenvalues()(0);
+  if (out.spread < o.min_spread)
+    throw MeasurementError(prefix(source) + fmt::format("magnetometer alignment: gravity was seen from too few "
+                                                        "directions (spread {:.3f}, need {}); turn the device through "
+                                                        "all orientations",
+                                                        out.spread, o.min_spread));
+  double w[3] = {0.0, 0.0, 0.0}, c = 0.0;
+  for (std::size_t i = 0; i < up.size(); ++i) c += up[i].dot(field[i]) / static_cast<double>(up.size());
+  ceres::Problem problem;
+  for (std::size_t i = 0; i < up.size(); ++i)
+    problem.AddResidualBlock(
+        new ceres::AutoDiffCostFunction<DotProductResidual, 1, 3, 1>(new DotProductResidual(up[i], field[i])),
+        new ceres::HuberLoss(o.huber_loss), w, &c);
+  const auto summary = solve_levenberg_marquardt(problem, 50, 1e-12);
+  if (!summary.IsSolutionUsable())
+    throw MeasurementError(prefix(source) + "magnetometer alignment: the fit did not converge");
+  out.R_calibrated_magnetometer =
+      Eigen::AngleAxisd(Vec3(w[0], w[1], w[2]).norm(), Vec3(w[0], w[1], w[2]).normalized().eval()).toRotationMatrix();
+  if (Vec3(w[0], w[1], w[2]).norm() < 1e-15) out.R_calibrated_magnetometer.setIdentity();
+  out.dip_rad = std::asin(std::clamp(-c, -1.0, 1.0));
+  double ss = 0.0;
+  for (std::size_t i = 0; i < up.size(); ++i) {
+    const double angle = std::acos(std::clamp(up[i].dot(out.R_calibrated_magnetometer * field[i]), -1.0, 1.0));
+    ss += std::pow(angle - (M_PI / 2 + out.dip_rad), 2);
+  }
+  out.residual_rms_rad = std::sqrt(ss / static_cast<double>(up.size()));
+  ceres::Covariance::Options co;
+  co.algorithm_type = ceres::DENSE_SVD;
+  ceres::Covariance covariance(co);
+  const std::vector<std::pair<const double*, const double*>> blocks = {{w, w}};
+  if (covariance.Compute(blocks, &problem)) {
+    double cov[9];
+    covariance.GetCovarianceBlock(w, w, cov);
+    // Ceres' covariance takes unit residual variance; scale by the residuals' own.
+    const double variance = 2.0 * summary.final_cost / std::max<double>(1.0, static_cast<double>(up.size()) - 4.0);
+    out.sigma_rad = Vec3(std::sqrt(cov[0] * variance), std::sqrt(cov[4] * variance), std::sqrt(cov[8] * variance));
+  }
+  return out;
 }
 
 }  // namespace antpose::calibration

@@ -55,4 +55,38 @@ struct MagnetometerCalibration {
 MagnetometerCalibration fit_magnetometer(const Stream& magnetometer, const MagnetometerOptions& options,
                                          Diagnostics& diagnostics, const std::filesystem::path& source = {});
 
+/// The magnetometer's axes against the accelerometer's, by the invariance of the angle between
+/// gravity and the Earth's field: wherever the device points, â · R m̂ = sin(−dip) for â the
+/// calibrated accelerometer's direction (up, at rest) and m̂ the hard- and soft-iron corrected
+/// field (Li & Li, "Effective method for magnetic sensor calibration using the dot product
+/// invariance", 2012; Kok & Schön, "Magnetometer calibration using inertial sensors", IEEE Sensors
+/// J. 2016, fit the same rotation jointly). A symmetric soft-iron correction cannot turn the axes,
+/// and the two chips' axes differ by tenths of a degree, which the compass takes for a heading:
+/// on a simulated typical phone (0.17, 0.12, 0.06)° turned the compass 0.07–0.38° at the photos
+/// of antenna sites (docs/non-contact.md). Fitted over the samples at which the accelerometer
+/// feels gravity alone (| |a| − g | below options.static_tolerance · g), R (angle-axis) and the
+/// dip by Levenberg–Marquardt with a Huber loss.
+struct MagnetometerAlignmentOptions {
+  double static_tolerance = 0.02;  // of g
+  std::size_t min_samples = 100;
+  double min_spread = 0.02;  // smallest eigenvalue of E[â âᵀ]: gravity seen from enough directions
+  double huber_loss = 0.01;  // of the dot product (≈ 0.6°)
+};
+
+struct MagnetometerAlignment {
+  Mat3 R_calibrated_magnetometer = Mat3::Identity();  // calibrated (accelerometer) frame ← magnetometer's
+  double dip_rad = 0.0;                               // of the field at the recording, down positive
+  std::size_t samples = 0;
+  double spread = 0.0;            // smallest eigenvalue of E[â âᵀ]
+  double residual_rms_rad = 0.0;  // of the angle between â and R m̂ about its mean
+  Vec3 sigma_rad = Vec3::Zero();  // 1σ per axis of R's rotation vector
+};
+
+/// `accelerometer` (m/s²) and `magnetometer` (µT) already corrected by their calibrations; the
+/// accelerometer is interpolated at the magnetometer's instants. Throws MeasurementError naming
+/// `source` for too few samples at rest-like acceleration or too little variety of attitudes.
+MagnetometerAlignment fit_magnetometer_alignment(const Stream& accelerometer, const Stream& magnetometer,
+                                                 double gravity, const MagnetometerAlignmentOptions& options,
+                                                 const std::filesystem::path& source = {});
+
 }  // namespace antpose::calibration

@@ -1,6 +1,9 @@
 #include "antpose/imu/imu_calibration.hpp"
 
+#include <algorithm>
 #include <cmath>
+
+#include <Eigen/SVD>
 
 #include <fmt/format.h>
 
@@ -98,6 +101,20 @@ ImuCalibration parse_imu_calibration(const std::string& text, const fs::path& fi
                                      "to the identity (determinant between 0.1 and 10)",
                                      det));
     }
+    if (mag["alignment"]) {
+      c.mag_alignment = mat3(mag["alignment"], file, "imu.magnetometer.alignment");
+      const double off = (c.mag_alignment * c.mag_alignment.transpose() - Mat3::Identity()).norm();
+      const double angle = std::acos(std::clamp((c.mag_alignment.trace() - 1.0) / 2.0, -1.0, 1.0));
+      if (off > 1e-3 || c.mag_alignment.determinant() < 0.0 || angle > deg2rad(10.0))
+        throw InputError(
+            file, line_of(mag["alignment"]),
+            fmt::format("imu.magnetometer.alignment is not a small rotation (RᵀR − I off by {:.2g}, "
+                        "determinant {:.3f}, angle {:.1f}°); expected a rotation within 10° of the identity",
+                        off, c.mag_alignment.determinant(), rad2deg(angle)));
+      // Rounded entries (a file written by hand): the nearest rotation.
+      const Eigen::JacobiSVD<Mat3> svd(c.mag_alignment, Eigen::ComputeFullU | Eigen::ComputeFullV);
+      c.mag_alignment = svd.matrixU() * svd.matrixV().transpose();
+    }
   }
   if (const auto acc = section(imu, "accelerometer", file, "imu.accelerometer")) {
     if (acc["bias_m_s2"]) c.acc_bias = vec3(acc["bias_m_s2"], file, "imu.accelerometer.bias_m_s2");
@@ -134,9 +151,11 @@ std::string format_imu_calibration(const ImuCalibration& c) {
     if (n && n.IsMap()) old_imu = n;
   }
   auto keep = [&](const char* key, bool calibrated) { return calibrated || (old_imu.IsMap() && old_imu[key]); };
-  if (keep("magnetometer", !c.mag_hard_iron_uT.isZero() || c.mag_soft_iron != Mat3::Identity() || c.mag_field_uT)) {
+  if (keep("magnetometer", !c.mag_hard_iron_uT.isZero() || c.mag_soft_iron != Mat3::Identity() ||
+                               c.mag_alignment != Mat3::Identity() || c.mag_field_uT)) {
     imu["magnetometer"]["hard_iron_uT"] = flow_vector(c.mag_hard_iron_uT);
     imu["magnetometer"]["soft_iron"] = flow_matrix(c.mag_soft_iron);
+    if (c.mag_alignment != Mat3::Identity()) imu["magnetometer"]["alignment"] = flow_matrix(c.mag_alignment);
     if (c.mag_field_uT) imu["magnetometer"]["field_uT"] = io::format_number(*c.mag_field_uT);
     if (c.mag_residual_rel) imu["magnetometer"]["residual_rel"] = io::format_number(*c.mag_residual_rel);
   }

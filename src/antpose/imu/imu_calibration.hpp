@@ -3,7 +3,8 @@
 // Model (device frame, SI units), correction form of imu_tk (Tedaldi, Pretto, Menegatti,
 // "A Robust and Easy to Implement Method for IMU Calibration without External Equipments",
 // ICRA 2014, eqs. 8 and 14):
-//   magnetometer  m = S · (m_raw − b_hard)                  b_hard µT, S soft iron (identity by default)
+//   magnetometer  m = R_m · S · (m_raw − b_hard)            b_hard µT, S soft iron (identity by default),
+//                                                           R_m its axes turned onto the accelerometer's
 //   accelerometer a = T_a · diag(k_a) · (a_raw − b_acc)     b_acc m/s², k_a per-axis scale,
 //   gyroscope     ω = T_g · diag(k_g) · (ω_raw − b_gyro)    T misalignment (unit diagonal), rad/s
 // The seed/lecture sensor model y = T_m K_m x + b is the same map inverted:
@@ -19,7 +20,7 @@
 //   device: {model: ..., id: ...}          optional
 //   imu:
 //     magnetometer:  {hard_iron_uT: [x, y, z], soft_iron: [[..], [..], [..]], field_uT: F,
-//                     residual_rel: r}
+//                     residual_rel: r, alignment: [[..], [..], [..]]}   alignment = R_m, a rotation
 //     accelerometer: {bias_m_s2: [x, y, z], scale: [x, y, z], misalignment: [[..], [..], [..]],
 //                     residual_rms_m_s2: r}
 //     gyroscope:     {bias_rad_s: [x, y, z], scale: [x, y, z], misalignment: [[..], [..], [..]],
@@ -44,6 +45,9 @@ struct ImuCalibration {
 
   Vec3 mag_hard_iron_uT = Vec3::Zero();
   Mat3 mag_soft_iron = Mat3::Identity();
+  /// R_calibrated_magnetometer: the corrected field from the magnetometer's axes into the
+  /// calibrated (accelerometer) frame (calibration::fit_magnetometer_alignment).
+  Mat3 mag_alignment = Mat3::Identity();
   Vec3 acc_bias = Vec3::Zero();   // m/s²
   Vec3 acc_scale = Vec3::Ones();
   Mat3 acc_misalignment = Mat3::Identity();  // T_a, unit diagonal
@@ -61,7 +65,7 @@ struct ImuCalibration {
   Mat3 gyro_correction() const { return gyro_misalignment * gyro_scale.asDiagonal(); }
   Vec3 correct_acc(const Vec3& raw) const { return acc_correction() * (raw - acc_bias); }
   Vec3 correct_gyro(const Vec3& raw) const { return gyro_correction() * (raw - gyro_bias); }
-  Vec3 correct_mag(const Vec3& raw) const { return mag_soft_iron * (raw - mag_hard_iron_uT); }
+  Vec3 correct_mag(const Vec3& raw) const { return mag_alignment * (mag_soft_iron * (raw - mag_hard_iron_uT)); }
   std::string device_model;
   std::string device_id;
   /// The file as read; unknown keys survive write_imu_calibration.
