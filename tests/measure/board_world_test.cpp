@@ -121,6 +121,49 @@ TEST(BoardWorld, OutliersAndDisturbanceAndOneSidedViewsAreReported) {
   EXPECT_TRUE(dl.mentions("shot 1 (t = 500.000 s) has no phone orientation (outside the sensor data); left out"));
 }
 
+// The board's heading from the compass at the photos: the track's heading error (here 1.5°) is
+// gone; what stays is the board's tilt error about the field's horizontal direction times
+// tan(dip), and the covariance says so.
+TEST(BoardWorld, HeadingFromTheFieldAtThePhotos) {
+  const double dip = deg2rad(60.0);
+  const Vec3 B_world(0.0, 50.0 * std::cos(dip), -50.0 * std::sin(dip));  // magnetic north, down
+  const Mat3 R_true = exp_so3(Vec3(0.3, -0.2, 1.1));
+  const Vec3 delta = deg2rad(1.0) * Vec3(0.2, 0.3, 1.5);  // R_true = exp(δ) R_est
+  BoardWorldAttitude board;
+  board.R_world_board = exp_so3(-delta) * R_true;
+  board.covariance = Vec3(std::pow(deg2rad(0.1), 2), std::pow(deg2rad(0.2), 2), std::pow(deg2rad(0.6), 2)).asDiagonal();
+  // Each photo sees the true field in its own device frame and is turned into the world by the
+  // board's attitude (the photos' tilts relative to the board are exact): exp(−δ) B, plus noise.
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> g(0.0, 0.01);
+  std::vector<Vec3> fields;
+  for (int i = 0; i < 12; ++i) fields.push_back(exp_so3(-delta) * B_world + Vec3(g(rng), g(rng), g(rng)));
+  CompassOptions options;
+  options.calibration_sigma_rad = deg2rad(0.15);
+  const auto r = heading_from_field(board, fields, options);
+  ASSERT_TRUE(r.compass_turn_rad);
+  const Vec3 e = log_so3(R_true * r.R_world_board.transpose());
+  std::printf("turn %.3f°, error (%.3f, %.3f, %.3f)°, heading σ %.3f°\n", rad2deg(*r.compass_turn_rad), rad2deg(e.x()),
+              rad2deg(e.y()), rad2deg(e.z()), rad2deg(std::sqrt(r.covariance(2, 2))));
+  // The tilt error about north (0.3°) turns the compass by tan(60°) · 0.3° = 0.52°.
+  EXPECT_NEAR(rad2deg(e.z()), -std::tan(dip) * 0.3, 0.03);  // to first order
+  EXPECT_NEAR(rad2deg(e.x()), 0.2, 0.015);                  // the tilt is the board's
+  EXPECT_NEAR(rad2deg(e.y()), 0.3, 0.015);
+  // Heading σ² = tan²(dip) σ_north² + σ_cal² + the photos' scatter over n (noise 0.01/25 µT ≈ 0.02°).
+  const double expected = std::pow(std::tan(dip) * 0.2, 2) + std::pow(0.15, 2);
+  EXPECT_GT(rad2deg(std::sqrt(r.covariance(2, 2))), std::sqrt(expected));
+  EXPECT_LT(rad2deg(std::sqrt(r.covariance(2, 2))), std::sqrt(expected) + 0.01);  // the dip as measured: 60.2°
+  EXPECT_NEAR(r.covariance(2, 1), -std::tan(dip) * std::pow(deg2rad(0.2), 2), 5e-7);
+  EXPECT_NEAR(r.covariance(0, 0), board.covariance(0, 0), 0.01 * board.covariance(0, 0));  // turned by 1.5°
+
+  // One field, or none with a horizontal part: the board as it was.
+  const auto one = heading_from_field(board, {fields.front()}, options);
+  EXPECT_FALSE(one.compass_turn_rad);
+  EXPECT_TRUE(one.R_world_board.isApprox(board.R_world_board));
+  const auto vertical = heading_from_field(board, std::vector<Vec3>(3, Vec3(0, 0, -40)), options);
+  EXPECT_FALSE(vertical.compass_turn_rad);
+}
+
 TEST(AntennaAttitude, ComposesBoardAndRegistrationWithTrueNorth) {
   const Scene s = scene(8, 0.0, 0.0, 6);
   Diagnostics d;

@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "antpose/camera/board_pose.hpp"
+#include "antpose/core/statistics.hpp"
 
 namespace antpose::measure {
 namespace {
@@ -141,6 +142,39 @@ BoardWorldAttitude board_world_attitude(const std::vector<BoardPhoto>& photos,
                      "than {}°): the reconstruction's depth and the registration are weak; walk around",
                      out.view_spread_deg, o.min_view_spread_deg));
   return out;
+}
+
+BoardWorldAttitude heading_from_field(BoardWorldAttitude board, const std::vector<Vec3>& field_world_uT,
+                                      const CompassOptions& o) {
+  std::vector<double> east_of_north;  // rad, clockwise from +y
+  Vec3 mean = Vec3::Zero();
+  for (const Vec3& b : field_world_uT)
+    if (b.head<2>().norm() > 1e-6 * b.norm()) {
+      east_of_north.push_back(std::atan2(b.x(), b.y()));
+      mean += b / b.norm();
+    }
+  const auto n = east_of_north.size();
+  if (n < o.min_photos || n == 0) return board;
+  // Angles relative to the first, so that a field near south does not wrap.
+  for (double& a : east_of_north) a = east_of_north.front() + wrap_pi(a - east_of_north.front());
+  const double turn = median(east_of_north);  // counter-clockwise: brings the field to +y
+  double scatter_sq = 0.0;
+  for (const double a : east_of_north) scatter_sq += std::pow(wrap_pi(a - turn), 2);
+  const double scatter_of_median =
+      n > 1 ? std::sqrt(scatter_sq / static_cast<double>(n - 1) / static_cast<double>(n)) : 0.0;
+
+  const Mat3 R_turn = exp_so3(Vec3(0.0, 0.0, turn));
+  const Vec3 b = R_turn * mean;
+  const double tan_dip = -b.z() / b.head<2>().norm();
+  const Vec3 h = Vec3(b.x(), b.y(), 0.0).normalized();
+  Mat3 A = Mat3::Identity();
+  A.row(2) = -tan_dip * h.transpose();
+  board.R_world_board = R_turn * board.R_world_board;
+  const Mat3 turned = R_turn * board.covariance * R_turn.transpose();
+  board.covariance = A * turned * A.transpose();
+  board.covariance(2, 2) += o.calibration_sigma_rad * o.calibration_sigma_rad + scatter_of_median * scatter_of_median;
+  board.compass_turn_rad = turn;
+  return board;
 }
 
 }  // namespace antpose::measure

@@ -65,6 +65,9 @@ struct BoardWorldAttitude {
   std::size_t used = 0;
   double heading_scatter_deg = 0.0;  // RMS over the photos used
   double view_spread_deg = 0.0;      // largest angle between viewing directions (board frame)
+  /// The turn about the vertical (rad, counter-clockwise seen from above) that gave the board the
+  /// compass's heading at the photos (heading_from_field); nullopt: the track's heading.
+  std::optional<double> compass_turn_rad;
   std::vector<std::string> warnings;
 };
 
@@ -73,6 +76,30 @@ struct BoardWorldAttitude {
 BoardWorldAttitude board_world_attitude(const std::vector<BoardPhoto>& photos,
                                         const orientation::OrientationTrack& track, const CameraImu& camera_imu,
                                         const BoardWorldOptions& options, Diagnostics& diagnostics);
+
+struct CompassOptions {
+  /// 1σ heading error of a calibrated magnetometer's field direction (hard- and soft-iron
+  /// residuals), rad. On the simulated phone the calibrated field at the photos, turned into the
+  /// world by the true attitudes, pointed 0.00–0.10° off magnetic north (4 sites).
+  double calibration_sigma_rad = deg2rad(0.15);
+  std::size_t min_photos = 2;
+};
+
+/// The board's heading from the compass at the photos rather than from the orientation track.
+/// `field_world_uT` is the field at each photo in the world frame through that photo's attitude
+/// from the board (field_at_photos, field_check.hpp): where the board's heading is right, its
+/// horizontal part points to magnetic north (+y). The board is turned about the vertical by the
+/// median of the photos' horizontal field directions. While walking, the track's heading carries
+/// its tilt errors through the dip (a 1° tilt error turns a compass by tan(dip)°), and smoothing
+/// spreads them over the capture: on simulated walks its heading at the photos was 0.2–1.4° off
+/// though the calibrated field there pointed within 0.1° of north (docs/non-contact.md). Here each
+/// photo's tilt is the board's, so only the board's own tilt error e reaches the heading:
+///   e'_z = −tan(dip) (ĥ · e),   ĥ the field's horizontal direction (world),
+/// and the covariance becomes A Σ Aᵀ + (σ_cal² + s²/n) ẑẑᵀ, A mapping e to e' and s the photos'
+/// heading scatter. Fewer than options.min_photos fields, or a field without a horizontal part:
+/// the board is returned unchanged.
+BoardWorldAttitude heading_from_field(BoardWorldAttitude board, const std::vector<Vec3>& field_world_uT,
+                                      const CompassOptions& options);
 
 /// The geodesic L1 median of rotations (Weiszfeld), started from their chordal mean.
 Mat3 l1_rotation_median(const std::vector<Mat3>& rotations, int max_iterations = 100);

@@ -1128,14 +1128,21 @@ NonContactResult measure_non_contact(const Capture& capture, const NonContactSet
                                setup.camera_imu.R_device_camera.transpose());
     }
     const auto fields = field_at_photos(data, track, shot_t, R_world_device, options.field.half_window_s);
+    std::vector<Vec3> field_world_uT;
+    for (const auto& f : fields)
+      if (f) field_world_uT.push_back(*f);
+    if (options.heading_from_compass) {
+      // The board's heading from the compass at the photos, not from the track (board_world.hpp).
+      result.board = heading_from_field(std::move(result.board), field_world_uT, options.compass);
+      const Mat3 R_turn = exp_so3(Vec3(0.0, 0.0, result.board.compass_turn_rad.value_or(0.0)));
+      for (Vec3& b : field_world_uT) b = R_turn * b;
+    }
     // Where each photo was taken: the camera centre in the board frame, turned to world axes.
-    std::vector<Vec3> field_world_uT, p_world_m;
+    std::vector<Vec3> p_world_m;
     for (std::size_t i = 0; i < fields.size(); ++i)
-      if (fields[i]) {
-        field_world_uT.push_back(*fields[i]);
+      if (fields[i])
         p_world_m.push_back(result.board.R_world_board *
                             camera::camera_centre(views[i].R_camera_board, views[i].t_camera_board));
-      }
     result.field = check_field(field_world_uT, result.site, options.field, p_world_m);
     // A disturbed compass turns the board's heading, shared by every antenna.
     result.board.covariance(2, 2) += std::pow(result.field.heading_sigma_rad, 2);
@@ -1244,6 +1251,8 @@ nlohmann::json to_json(const NonContactResult& r) {
   j["board"] = {{"R_world_board", io::matrix_rows_json(r.board.R_world_board)},
                 {"photos_used", r.board.used},
                 {"heading_scatter_deg", r.board.heading_scatter_deg},
+                {"compass_turn_deg", r.board.compass_turn_rad ? nlohmann::json(rad2deg(*r.board.compass_turn_rad))
+                                                              : nlohmann::json(nullptr)},
                 {"view_spread_deg", r.board.view_spread_deg},
                 {"heading_sigma_deg", rad2deg(std::sqrt(r.board.covariance(2, 2)))},
                 {"tilt_sigma_deg", rad2deg(std::sqrt((r.board.covariance(0, 0) + r.board.covariance(1, 1)) / 2))}};

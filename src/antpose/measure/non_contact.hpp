@@ -136,6 +136,10 @@ struct NonContactOptions {
     o.common_sigma_rad = Vec2(deg2rad(0.1), deg2rad(0.6));
     return o;
   }();
+  /// The board's heading from the compass at the photos, each photo's tilt from the board
+  /// (heading_from_field, board_world.hpp); false: from the orientation track at the photos.
+  bool heading_from_compass = true;
+  CompassOptions compass;
   FieldCheckOptions field;        // magnetic disturbance (field_check.hpp)
   double model_spacing_m = 0.01;  // model surface samples
   double warn_rmse_m = 0.015;     // fit RMSE above this: poor fit warning
