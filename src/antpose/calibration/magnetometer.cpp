@@ -239,9 +239,7 @@ MagnetometerAlignment fit_magnetometer_alignment(const Stream& accelerometer, co
   const auto summary = solve_levenberg_marquardt(problem, 50, 1e-12);
   if (!summary.IsSolutionUsable())
     throw MeasurementError(prefix(source) + "magnetometer alignment: the fit did not converge");
-  out.R_calibrated_magnetometer =
-      Eigen::AngleAxisd(Vec3(w[0], w[1], w[2]).norm(), Vec3(w[0], w[1], w[2]).normalized().eval()).toRotationMatrix();
-  if (Vec3(w[0], w[1], w[2]).norm() < 1e-15) out.R_calibrated_magnetometer.setIdentity();
+  out.R_calibrated_magnetometer = exp_so3(Vec3(w[0], w[1], w[2]));
   out.dip_rad = std::asin(std::clamp(-c, -1.0, 1.0));
   double ss = 0.0;
   for (std::size_t i = 0; i < up.size(); ++i) {

@@ -3,8 +3,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include <Eigen/SVD>
-
 #include <fmt/format.h>
 
 #include "antpose/io/csv.hpp"
@@ -112,8 +110,7 @@ ImuCalibration parse_imu_calibration(const std::string& text, const fs::path& fi
                         "determinant {:.3f}, angle {:.1f}°); expected a rotation within 10° of the identity",
                         off, c.mag_alignment.determinant(), rad2deg(angle)));
       // Rounded entries (a file written by hand): the nearest rotation.
-      const Eigen::JacobiSVD<Mat3> svd(c.mag_alignment, Eigen::ComputeFullU | Eigen::ComputeFullV);
-      c.mag_alignment = svd.matrixU() * svd.matrixV().transpose();
+      c.mag_alignment = nearest_rotation(c.mag_alignment);
     }
   }
   if (const auto acc = section(imu, "accelerometer", file, "imu.accelerometer")) {
