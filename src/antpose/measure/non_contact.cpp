@@ -696,14 +696,17 @@ PointsFit points_fit(const PointCloud& cloud, const registration::KdTree& model,
 // Other places for the model (T_antenna_board), each centre more than `apart_m` from the
 // winner's and from each other's: the points' best poses (global_start.hpp's hypotheses, best
 // first), at most `count`; then the winner moved by the model's depth along its boresight, both
-// ways; last the winner slid along its long axis by 1/16 and 1/8 of the model's length, both
-// ways (nearer than `apart_m`: the outline's basin along the axis is narrow). A region's points
-// lie on the radome's front and on the arms and clamps behind the back plate, and the box can
-// rest on either: on 3208-1 (a 2 m panel from the ground, refused) the points' box sat 0.14 m
-// behind the panel, where no outline start reached the panel's basin. Where other panels hide
-// part of it, the points fix the box's position along its axis poorly: on 3811-3 (a 2 m panel
-// behind two thesis panels on a rooftop, refused) it sat 0.12 m along the axis from the panel,
-// and every start from there failed, where the same starts at the panel's centre converged.
+// ways; last the winner slid along its long axis by 1/16 and 1/8 of the model's length and along
+// its boresight by half its depth, both ways (nearer than `apart_m`: the outline's basin is
+// narrow). A region's points lie on the radome's front and on the arms and clamps behind the
+// back plate, and the box can rest on either: on 3208-1 (a 2 m panel from the ground, refused)
+// the points' box sat 0.14 m behind the panel, where no outline start reached the panel's basin.
+// A whole depth (0.15 m) forward reached it only by a hair: a board tilt different by 1e-14 (the
+// magnetometer's alignment written with other last digits) left it refused again; half a depth
+// reaches it from both. Where other panels hide part of it, the points fix the box's position
+// along its axis poorly: on 3811-3 (a 2 m panel behind two thesis panels on a rooftop, refused)
+// it sat 0.12 m along the axis from the panel, and every start from there failed, where the same
+// starts at the panel's centre converged.
 std::vector<Iso3> other_positions(const registration::GlobalStartResult& start, const Vec3& size_m, double apart_m,
                                   std::size_t count) {
   const Iso3& winner = start.fit.T_target_source;
@@ -724,7 +727,9 @@ std::vector<Iso3> other_positions(const registration::GlobalStartResult& start, 
     return T_board_antenna.inverse();
   };
   for (const double sign : {1.0, -1.0}) add(moved(sign * size_m.y(), 1));
-  for (const double share : {1.0 / 16, -1.0 / 16, 1.0 / 8, -1.0 / 8}) out.push_back(moved(share * size_m.z(), 2));
+  const std::pair<double, int> slides[] = {{1.0 / 16, 2}, {-1.0 / 16, 2}, {1.0 / 8, 2},
+                                           {-1.0 / 8, 2}, {0.5, 1},       {-0.5, 1}};  // (share of the size, axis)
+  for (const auto& [share, axis] : slides) out.push_back(moved(share * size_m(axis), axis));
   return out;
 }
 

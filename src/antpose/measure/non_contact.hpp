@@ -84,7 +84,8 @@ struct NonContactOptions {
   /// Where no outline start converged, the free outline search is repeated from the points' best
   /// poses at other places (registration/global_start.hpp's hypotheses): up to this many, each
   /// more than other_position_m from the winner's centre and from each other's; then the winner
-  /// moved by the model's depth along its boresight and slid along its axis (other_positions).
+  /// moved by the model's depth along its boresight and slid along its axis and by half its depth
+  /// (other_positions).
   std::size_t other_positions = 2;
   double other_position_m = 0.15;
   double silhouette_rival_margin = 0.02;  // a converged start within this score is a rival
