@@ -222,17 +222,25 @@ struct SilhouettePick {
   std::vector<std::string> closest_failure;  // the best-scoring rejected start's reasons, when none converged
 };
 
+// Where a search's starts stand and what its descents keep.
+struct SearchStarts {
+  std::optional<Vec3> axis;  // the starts' long axis (board frame); none: upright, the board's up
+  bool hold_axis = false;    // every descent keeps `axis` (refine_holding_axis)
+  bool placed = false;       // each start first moved onto the outline with its rotation held
+};
+
 SilhouettePick silhouette_search(const model::AntennaModel& model, const Iso3& T_board_antenna, const Scene& scene,
-                                 const NonContactOptions& options,
-                                 const std::optional<Vec3>& held_axis = std::nullopt) {
+                                 const NonContactOptions& options, const SearchStarts& starts = {}) {
   SilhouettePick pick;
+  const std::optional<Vec3> held_axis = starts.hold_axis ? starts.axis : std::nullopt;
   std::vector<registration::SilhouetteResult> done;
   double failed_score = 2.0;
   // Starts upright (the long axis along the board frame's up: panels hang within ~15° of it),
   // turned about it from the points' boresight, at the points' position. The points' own tilt
-  // is not kept: on a cluttered region it can be the wrong basin for the outline. With a held
-  // axis the starts lie on it and every descent keeps it (refine_holding_axis).
-  const Vec3 up = held_axis ? held_axis->normalized() : Vec3(scene.up_board.normalized());
+  // is not kept: on a cluttered region it can be the wrong basin for the outline. Given an axis
+  // (SearchStarts) the starts lie on it, and where it is held every descent keeps it
+  // (refine_holding_axis).
+  const Vec3 up = starts.axis ? starts.axis->normalized() : Vec3(scene.up_board.normalized());
   // Every start descends with both edge searches (SilhouetteOptions::line_ends_at_middle) where
   // they differ (descend_both), and the scores, on the same fine search, choose: on a panel
   // narrower than the search range its far side is often the stronger edge and lures the descents
@@ -280,8 +288,23 @@ SilhouettePick silhouette_search(const model::AntennaModel& model, const Iso3& T
     start.linear().col(2) = up;
     return start;
   };
+  // A placed start keeps its rotation and takes its position from the outline first: from a
+  // place well off the panel across the line of sight, a free descent trades the rotation for the
+  // position and settles on the mast's and the arms' edges beside it (4502-1, a 2 m panel 25 m
+  // away seen from its side beside the mast: the points' box 7 cm to the side, and every start
+  // from there ended 30-80° off at 0.48-0.51, where the same starts placed first reached the
+  // truth's basin, 0.2° from it).
+  auto placing = options;
+  placing.silhouette_options.free = {false, false, false, true, true, true};
+  placing.silhouette_options.rival_yaw_offsets_rad.clear();
+  const auto start_at = [&](double yaw_deg) {
+    Iso3 start = upright_at(yaw_deg);
+    if (starts.placed)
+      start.translation() = refine_outline(model, start, scene, placing, false).T_board_antenna.translation();
+    return start;
+  };
   for (const double yaw : options.silhouette_yaw_starts_deg) {
-    for (auto& r : descend_both(upright_at(yaw), options.silhouette_redescents)) {
+    for (auto& r : descend_both(start_at(yaw), options.silhouette_redescents)) {
       if (r.converged && r.score > options.silhouette_max_score) {
         r.converged = false;
         r.warnings.push_back(fmt::format("the outline fits poorly: score {:.2f} (at most {:.2f})", r.score,
@@ -305,7 +328,7 @@ SilhouettePick silhouette_search(const model::AntennaModel& model, const Iso3& T
   // competes only where a descent converged: alone, it settles on whatever edges lie within its
   // ±4 px, and it won confidently wrong where the held-axis search was needed (1304-2, 45° off
   // with σ 1.6°; 604-1 and 1706-2).
-  for (auto& r : descend_both(upright_at(0.0), 0, true)) keep_if_fits(r);
+  for (auto& r : descend_both(start_at(0.0), 0, true)) keep_if_fits(r);
   const auto by_score = [](const auto& a, const auto& b) { return a.score < b.score; };
   std::sort(done.begin(), done.end(), by_score);
   // Seen from below, a downtilt tilts the panel's axis along the line of sight, which hardly moves
@@ -794,6 +817,10 @@ OutlineSearch search_outline(const PointCloud& cloud_board, const model::Antenna
   const Iso3& T_antenna_board = points.start.fit.T_target_source;
   OutlineSearch s;
   auto& pick = s.pick;
+  const auto points_axis = [&] {
+    const Vec3 axis = points_long_axis(points.cloud, points.model, T_antenna_board, options);
+    return axis.dot(site.up_board) < 0.0 ? Vec3(-axis) : axis;
+  };
   if (pass == OutlinePass::kFirst) pick = silhouette_search(model, T_antenna_board.inverse(), site, options);
   // A narrow panel seen from below can trade yaw for tilt in its outline, and the mast's edges
   // beside it lure the descents away or the mast hides part of it: where no start converged, the
@@ -806,9 +833,8 @@ OutlineSearch search_outline(const PointCloud& cloud_board, const model::Antenna
   const bool doubtful = pick.best && (pick.best->score > options.silhouette_doubtful_score || pick.rival_yaw);
   if ((!pick.best || doubtful) && options.held_axis_search) {
     auto with_the_mast = with_mast(cloud_board, site, T_antenna_board, model, options);
-    Vec3 axis = points_long_axis(points.cloud, points.model, T_antenna_board, options);
-    if (axis.dot(site.up_board) < 0.0) axis = -axis;
-    auto held = silhouette_search(model, T_antenna_board.inverse(), with_the_mast.scene, options, axis);
+    const Vec3 axis = points_axis();
+    auto held = silhouette_search(model, T_antenna_board.inverse(), with_the_mast.scene, options, {axis, true});
     held.tried += pick.tried;
     // The held search knows the mast, which hides part of the outline, so its scores are not the
     // free search's: the free winner is descended again in its scene and compared there. On
@@ -835,19 +861,28 @@ OutlineSearch search_outline(const PointCloud& cloud_board, const model::Antenna
   // The points' winner may sit on the mast beside the panel (a rooftop pipe with more points than
   // a sparse radome: 3201-1, 0.41 m off, no outline start within reach): the free search is
   // repeated from the points' best poses started elsewhere, in turn, their outline judging them.
-  if (!pick.best && pass == OutlinePass::kFirst)
-    for (const Iso3& T :
-         other_positions(points.start, model.size_m, options.other_position_m, options.other_positions)) {
-      auto other = silhouette_search(model, T.inverse(), site, options);
-      other.tried += pick.tried;
-      if (other.best) {
-        s.with_the_mast.reset();
-        s.held_axis.reset();
-        pick = std::move(other);
-        break;
-      }
-      pick.tried = other.tried;
+  // Last, the free search from the points' pose again, its starts on the points' long axis and
+  // each placed first (SearchStarts::placed): on 4502-1 the points' axis lay 0.2° from the
+  // truth's where upright was 6.9° off, and their box 7 cm to the side of the panel. Both run
+  // only where all else failed, so no answer found before them changes.
+  const auto search_again = [&](const Iso3& T_board_start, const SearchStarts& starts) {
+    auto again = silhouette_search(model, T_board_start, site, options, starts);
+    again.tried += pick.tried;
+    if (!again.best) {
+      pick.tried = again.tried;
+      return false;
     }
+    s.with_the_mast.reset();
+    s.held_axis.reset();
+    pick = std::move(again);
+    return true;
+  };
+  if (!pick.best && pass == OutlinePass::kFirst) {
+    bool found = false;
+    for (const Iso3& T : other_positions(points.start, model.size_m, options.other_position_m, options.other_positions))
+      if ((found = search_again(T.inverse(), {}))) break;
+    if (!found) search_again(T_antenna_board.inverse(), {points_axis(), false, true});
+  }
   return s;
 }
 
