@@ -233,6 +233,29 @@ TEST(Silhouette, FixedDegreesOfFreedomStayPut) {
   EXPECT_TRUE((r.covariance.bottomRightCorner<3, 3>().isZero()));
 }
 
+// A start placed first (measure's fallback, SearchStarts::placed): 9 cm off across the line of
+// sight and turned 3°, the translation alone descends onto the outline, the rotation untouched;
+// from there the free descent reaches the truth.
+TEST(Silhouette, ATranslationOnlyDescentPlacesAStartOnTheOutline) {
+  const auto& s = scene();
+  const Mat3& R = s.T_board_antenna.linear();
+  const Iso3 start = perturbed(s.T_board_antenna, 3.0, 1.0, 0.08 * R.col(0) + 0.04 * R.col(1));
+  SilhouetteOptions o;
+  o.free = {false, false, false, true, true, true};  // translation only
+  o.rival_yaw_offsets_rad.clear();
+  const auto placed = refine_by_silhouette(s.mesh_antenna, start, s.views, s.intrinsics, o);
+  const double before_m = (start.translation() - s.T_board_antenna.translation()).norm();
+  const double after_m = (placed.T_board_antenna.translation() - s.T_board_antenna.translation()).norm();
+  std::printf("placed: %.1f mm -> %.1f mm from the truth, score %.3f\n", 1e3 * before_m, 1e3 * after_m, placed.score);
+  EXPECT_TRUE(placed.T_board_antenna.linear() == start.linear());
+  EXPECT_LT(after_m, 0.25 * before_m);
+  const auto r = refine_by_silhouette(s.mesh_antenna, placed.T_board_antenna, s.views, s.intrinsics, {});
+  const Vec3 after = axis_errors_deg(r.T_board_antenna.linear(), R);
+  EXPECT_TRUE(r.converged);
+  EXPECT_LT(std::abs(after.z()), 0.3);
+  EXPECT_LT((r.T_board_antenna.translation() - s.T_board_antenna.translation()).norm(), 0.01);
+}
+
 // Crops given by the caller (the projected truth's box + 60 px, as a detector would give) serve
 // as well as the ones derived from the start.
 TEST(Silhouette, UsesGivenRegionsOfInterest) {
