@@ -294,13 +294,16 @@ SilhouettePick silhouette_search(const model::AntennaModel& model, const Iso3& T
   // away seen from its side beside the mast: the points' box 7 cm to the side, and every start
   // from there ended 30-80° off at 0.48-0.51, where the same starts placed first reached the
   // truth's basin, 0.2° from it).
-  auto placing = options;
-  placing.silhouette_options.free = {false, false, false, true, true, true};
-  placing.silhouette_options.rival_yaw_offsets_rad.clear();
+  std::optional<NonContactOptions> placing;
+  if (starts.placed) {
+    placing = options;
+    placing->silhouette_options.free = {false, false, false, true, true, true};
+    placing->silhouette_options.rival_yaw_offsets_rad.clear();
+  }
   const auto start_at = [&](double yaw_deg) {
     Iso3 start = upright_at(yaw_deg);
-    if (starts.placed)
-      start.translation() = refine_outline(model, start, scene, placing, false).T_board_antenna.translation();
+    if (placing)
+      start.translation() = refine_outline(model, start, scene, *placing, false).T_board_antenna.translation();
     return start;
   };
   for (const double yaw : options.silhouette_yaw_starts_deg) {
@@ -817,9 +820,13 @@ OutlineSearch search_outline(const PointCloud& cloud_board, const model::Antenna
   const Iso3& T_antenna_board = points.start.fit.T_target_source;
   OutlineSearch s;
   auto& pick = s.pick;
+  std::optional<Vec3> axis_points;  // an ICP: run once, for the held search or the last fallback
   const auto points_axis = [&] {
-    const Vec3 axis = points_long_axis(points.cloud, points.model, T_antenna_board, options);
-    return axis.dot(site.up_board) < 0.0 ? Vec3(-axis) : axis;
+    if (!axis_points) {
+      const Vec3 axis = points_long_axis(points.cloud, points.model, T_antenna_board, options);
+      axis_points = axis.dot(site.up_board) < 0.0 ? Vec3(-axis) : axis;
+    }
+    return *axis_points;
   };
   if (pass == OutlinePass::kFirst) pick = silhouette_search(model, T_antenna_board.inverse(), site, options);
   // A narrow panel seen from below can trade yaw for tilt in its outline, and the mast's edges
