@@ -2,9 +2,11 @@
 
 #include <chrono>
 #include <cstdio>
+#include <limits>
 
 #include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
 
 #include "reconstruction/scene_fixture.hpp"
 
@@ -115,6 +117,49 @@ TEST(BundleAdjust, WarnsWhenNoFeaturesTieTheViews) {
   // Board-only refinement = PnP.
   for (std::size_t k = 0; k < views.size(); ++k)
     EXPECT_LT(rad2deg(rotation_distance(refined.R_camera_board[k], views[k].R_camera_board)), 1e-3);
+}
+
+// Features that agree with each other but not with the board (each photo's scene shifted as if
+// the camera had turned, the board's corners where they were): the poses rest on the board
+// alone, and the result says why (site 3802: false tracks turned every camera by 0.03–0.10°).
+TEST(BundleAdjust, FeaturesThatPullThePosesOffTheBoardAreLeftOut) {
+  SceneOptions sharp_board;
+  sharp_board.board_noise_px = 0.05;  // corners as sharp as a 12 MP photo's (0.04–0.05 px RMS)
+  const Scene scene = make_scene(sharp_board);
+  std::vector<Mat3> R_pnp;
+  std::vector<Vec3> t_pnp;
+  for (const auto& v : scene.views) R_pnp.push_back(v.R_camera_board), t_pnp.push_back(v.t_camera_board);
+  auto views = scene.views;
+  const double step_px = 6.0;  // −12 … +12 px across the five photos
+  for (std::size_t k = 0; k < views.size(); ++k) {
+    const double shift_px = step_px * (double(k) - 0.5 * double(views.size() - 1));
+    const cv::Mat M = (cv::Mat_<double>(2, 3) << 1, 0, shift_px, 0, 1, 0.5 * shift_px);
+    cv::Mat shifted;
+    cv::warpAffine(views[k].image, shifted, M, views[k].image.size(), cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+    views[k].image = shifted;
+  }
+  const auto refined = refine_camera_poses(views, scene.K, {});
+  ASSERT_FALSE(refined.warnings.empty());
+  EXPECT_NE(refined.warnings.front().find("pull the camera poses away from the board"), std::string::npos)
+      << refined.warnings.front();
+  EXPECT_EQ(refined.tracks, 0u);
+  for (std::size_t k = 0; k < views.size(); ++k)
+    EXPECT_LT(rad2deg(rotation_distance(refined.R_camera_board[k], R_pnp[k])), 1e-3);
+  // Kept, those features would have turned the cameras further from the truth than the board's
+  // PnP, and pulled its corners off.
+  PoseRefinementOptions keep_all;
+  keep_all.max_board_rms_growth = std::numeric_limits<double>::infinity();
+  const auto pulled = refine_camera_poses(views, scene.K, keep_all);
+  const auto e_pnp = pose_errors(scene, R_pnp, t_pnp);
+  const auto e_pulled = pose_errors(scene, pulled.R_camera_board, pulled.t_camera_board);
+  std::printf("board alone: %.4f° %.2f mm; the shifted features kept: %.4f° %.2f mm, board %.3f px\n",
+              e_pnp.rotation_deg, e_pnp.translation_mm, e_pulled.rotation_deg, e_pulled.translation_mm,
+              pulled.board_rms_px);
+  EXPECT_GT(e_pulled.rotation_deg, 2 * e_pnp.rotation_deg);
+  // The photos as taken: their features agree with the board, are kept and improve the poses.
+  const auto kept = refine_camera_poses(scene.views, scene.K, {});
+  EXPECT_GT(kept.tracks, 200u);
+  EXPECT_LT(pose_errors(scene, kept.R_camera_board, kept.t_camera_board).rotation_deg, e_pnp.rotation_deg);
 }
 
 TEST(BundleAdjust, Rejects) {

@@ -56,6 +56,11 @@ struct PoseRefinementOptions {
   double huber_px = 1.0;             // robust loss on the scene points' reprojections
   double max_reprojection_px = 3.0;  // observations beyond this after a first solve are removed
   int max_iterations = 50;
+  /// The scene's tracks are rejected, and the poses rest on the board alone, where with them the
+  /// board's reprojection RMS exceeds this many times its RMS at the board-only poses (or at
+  /// board_rms_floor_px, the corners' usual sub-pixel accuracy, where that is larger).
+  double max_board_rms_growth = 2.0;
+  double board_rms_floor_px = 0.05;
 };
 
 struct RefinedPoses {
@@ -69,6 +74,8 @@ struct RefinedPoses {
   std::vector<std::string> warnings;
 };
 
+/// Where the features pull the board's corners off their fit (max_board_rms_growth), they are
+/// dropped with a warning and the poses are the board's alone (docs/reconstruction.md §1).
 /// MeasurementError for fewer than 2 views or views of different sizes than the intrinsics.
 RefinedPoses refine_camera_poses(const std::vector<PosedView>& views, const camera::CameraIntrinsics& intrinsics,
                                  const PoseRefinementOptions& options, const Progress& progress = {});
