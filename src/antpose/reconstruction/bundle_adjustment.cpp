@@ -7,6 +7,7 @@
 // left perturbation R_true = exp(δ) R_est that board_pose.hpp reports.
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <mutex>
 
 #include <ceres/ceres.h>
@@ -148,14 +149,16 @@ RefinedPoses refine_camera_poses(const std::vector<PosedView>& views, const came
   // 3. Tracks and their points with the current poses: epipolar filter (extra px per pair),
   //    union-find chaining, triangulation with a reprojection limit.
   std::vector<Mat3> R(n);
-  std::vector<Vec3> t(n);
-  for (int v = 0; v < n; ++v) R[v] = views[v].R_camera_board, t[v] = views[v].t_camera_board;
-  std::vector<Eigen::Matrix<double, 6, 1>> cam(n, Eigen::Matrix<double, 6, 1>::Zero());
-  for (int v = 0; v < n; ++v) cam[v].tail<3>() = t[v];
-  // The poses as given (the board's PnP) and their board residual: the reference the scene's
-  // tracks are checked against after the solve.
-  const std::vector<Mat3> R_board_only = R;
-  const auto cam_board_only = cam;
+  std::vector<Eigen::Matrix<double, 6, 1>> cam(n);
+  // The poses as given, the board's PnP: the start, and the result where the features are
+  // rejected (after the final solve).
+  const auto start_at_board_poses = [&] {
+    for (int v = 0; v < n; ++v) {
+      R[v] = views[v].R_camera_board;
+      cam[v] << Vec3::Zero(), views[v].t_camera_board;
+    }
+  };
+  start_at_board_poses();
   std::vector<Vec3> points;
   std::vector<SceneObservation> scene;
   std::vector<char> active;
@@ -308,9 +311,7 @@ RefinedPoses refine_camera_poses(const std::vector<PosedView>& views, const came
 
   // Covariance of each camera's (δ, t) at the solution, scaled by the whitened residual
   // variance (cost per degree of freedom), Hartley & Zisserman §5.2.3 / Triggs et al. §6.
-  auto solve_with_covariance = [&] {
-    ceres::Problem problem;
-    build_and_solve(problem);
+  auto pose_covariance = [&](ceres::Problem& problem) {
     ceres::Problem::EvaluateOptions eo;
     double cost = 0;
     problem.Evaluate(eo, &cost, nullptr, nullptr, nullptr);
@@ -335,7 +336,8 @@ RefinedPoses refine_camera_poses(const std::vector<PosedView>& views, const came
       out.warnings.push_back("the pose covariances could not be computed (rank-deficient bundle adjustment)");
     }
   };
-  solve_with_covariance();
+  auto problem = std::make_unique<ceres::Problem>();
+  build_and_solve(*problem);
   report("bundle adjustment", 2, 3);
 
   // The board is the reference: true tracks move the cameras within what its corners allow, so
@@ -354,10 +356,12 @@ RefinedPoses refine_camera_poses(const std::vector<PosedView>& views, const came
         "{:.2f} px without): they hold false matches that agree with each other (a repeating or moiré texture, "
         "something that moved), so the poses rest on the board alone",
         board_rms_with_scene, board_only_rms));
-    R = R_board_only, cam = cam_board_only;
+    start_at_board_poses();
     active.assign(scene.size(), 0);
-    solve_with_covariance();
+    problem = std::make_unique<ceres::Problem>();
+    build_and_solve(*problem);
   }
+  pose_covariance(*problem);
   report("bundle adjustment", 3, 3);
 
   for (int v = 0; v < n; ++v) {
