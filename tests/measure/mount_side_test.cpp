@@ -103,6 +103,19 @@ Tilted tilted(double downtilt_deg, double azimuth_deg) {
   return t;
 }
 
+// Scores measured on simulated sites (score, score with the attachments' outline).
+TEST(MountSide, OnlyTheAttachmentsOutlineTurnsAPanelRound) {
+  const double margin = 0.02;
+  // 502-1: the brackets fit far better turned round, and most of the gain is theirs.
+  EXPECT_TRUE(attachments_turn_round({0.0857, 0.1651}, {0.0067, 0.0320}, margin));
+  // 4706-1: no bracket sample in any photo; the turned pose's polish fitted the box better.
+  EXPECT_FALSE(attachments_turn_round({0.2505, 0.2505}, {0.1458, 0.1458}, margin));
+  // 4706-2: the attachments' part better by 0.021, but the whole by less than the margin.
+  EXPECT_FALSE(attachments_turn_round({0.2695, 0.2824}, {0.2724, 0.2643}, margin));
+  // The same pose either way round: nothing to tell.
+  EXPECT_FALSE(attachments_turn_round({0.05, 0.08}, {0.05, 0.08}, margin));
+}
+
 TEST(MountSide, DowntiltOfTheBoresight) {
   const auto t = tilted(7.0, 123.0);
   EXPECT_NEAR(rad2deg(boresight_downtilt(t.R, t.up)), 7.0, 1e-9);

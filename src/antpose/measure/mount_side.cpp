@@ -42,6 +42,12 @@ MountVerdict mast_side_verdict(const Vec3& axis_point, const Vec3& axis_dir, dou
   return MountVerdict::kUndecided;
 }
 
+bool attachments_turn_round(const OutlineScores& registered, const OutlineScores& turned, double margin) {
+  const double whole = registered.score_with_attachments - turned.score_with_attachments;
+  const double attachments = whole - (registered.score - turned.score);
+  return whole > margin && attachments > margin;
+}
+
 double boresight_downtilt(const Mat3& R, const Vec3& up) {
   return -std::asin(std::clamp(R.col(1).dot(up.normalized()), -1.0, 1.0));
 }

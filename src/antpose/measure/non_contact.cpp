@@ -15,6 +15,7 @@
 
 #include "antpose/camera/board_pose.hpp"
 #include "antpose/io/report_text.hpp"
+#include "antpose/measure/long_axis.hpp"
 #include "antpose/model/box_file.hpp"
 #include "antpose/model/sampling.hpp"
 #include "antpose/reconstruction/mast.hpp"
@@ -140,6 +141,13 @@ Mat3 across_long_axis(const Mat3& R_board_antenna, double variance) {
 // R_board_antenna turned the shortest way to put its long axis on `axis_board`.
 Mat3 with_long_axis(const Mat3& R_board_antenna, const Vec3& axis_board) {
   return Eigen::Quaterniond::FromTwoVectors(R_board_antenna.col(2), axis_board).toRotationMatrix() * R_board_antenna;
+}
+
+// The mean line of sight from the camera centres to `p_board` (board frame, not normalised).
+Vec3 mean_line_of_sight(const Scene& scene, const Vec3& p_board) {
+  Vec3 sight = p_board;
+  for (const Vec3& c : scene.viewpoints) sight -= c / static_cast<double>(scene.viewpoints.size());
+  return sight;
 }
 
 // R_board_antenna turned by 180° about the antenna's own long axis: front and back swapped, the
@@ -341,9 +349,7 @@ SilhouettePick silhouette_search(const model::AntennaModel& model, const Iso3& T
   // of sight is refined again, and the scores choose. A held axis holds the tilt.
   if (!held_axis && options.silhouette_tilt_probe_deg > 0.0) {
     const Iso3 winner = done.front().T_board_antenna;
-    Vec3 sight = winner.translation();
-    for (const Vec3& c : scene.viewpoints) sight -= c / static_cast<double>(scene.viewpoints.size());
-    const Vec3 across = winner.linear().col(2).cross(sight);
+    const Vec3 across = winner.linear().col(2).cross(mean_line_of_sight(scene, winner.translation()));
     if (across.norm() > 1e-9)
       for (const double sign : {-1.0, 1.0}) {
         Iso3 start = winner;
@@ -378,8 +384,8 @@ SilhouettePick silhouette_search(const model::AntennaModel& model, const Iso3& T
   pick.best = std::move(done.front());
   // Front and back by the outline too: the brackets show in it from the side. The winner turned
   // by 180° about its own long axis (the same line in the photos, the boresight reversed and the
-  // downtilt's sign with it) is refined; clearly better with the brackets' outline counted, it
-  // wins; about as good, it is a rival.
+  // downtilt's sign with it) is refined; clearly better by the brackets' outline
+  // (attachments_turn_round), it wins; about as good, it is a rival.
   Iso3 turned = pick.best->T_board_antenna;
   turned.linear() = turned_round(turned.linear());
   // Its box's outline is the winner's, at its minimum already, so it is only polished
@@ -394,7 +400,8 @@ SilhouettePick silhouette_search(const model::AntennaModel& model, const Iso3& T
   if (!flipped.converged) {
     flipped = *pick.best;
     flipped.T_board_antenna = turned;
-  } else if (flipped.score_with_attachments < pick.best->score_with_attachments - options.silhouette_rival_margin) {
+  } else if (attachments_turn_round({pick.best->score, pick.best->score_with_attachments},
+                                    {flipped.score, flipped.score_with_attachments}, options.silhouette_rival_margin)) {
     pick.rivals.clear();
     std::swap(flipped, *pick.best);
     pick.flipped_by_outline = true;
@@ -419,19 +426,21 @@ Vec3 points_long_axis(const registration::PreparedCloud& cloud, const registrati
 // where the mount cannot (options.max_uptilt_deg): as registered, the rivals
 // facing the other way go; turned, the turned pose wins. Where the mount's choice would tilt the
 // panel up beyond that limit the two disagree, and the other way round stays a rival. The
-// downtilt is read with the long axis the measurement keeps (the points' beyond the axis gate).
+// downtilt is read with the long axis the measurement keeps (keep_axis).
 void decide_front_by_mount(AntennaMeasurement& m, SilhouettePick& pick, const model::AntennaModel& model,
                            const registration::PreparedCloud& model_prepared, const Vec3& axis_points, double reach,
-                           const Vec3& up_board, const NonContactOptions& options) {
+                           const Scene& scene, const NonContactOptions& options) {
+  const Vec3& up_board = scene.up_board;
   const auto count = [&](const Mat3& R_board_antenna) {
     Iso3 T_board_antenna = pick.best->T_board_antenna;
     T_board_antenna.linear() = R_board_antenna;
     return count_mount_side(m.region.cloud_board, T_board_antenna.inverse(), model_prepared.tree, model.size_m, reach,
                             options.mount);
   };
+  const Vec3 sight = mean_line_of_sight(scene, pick.best->T_board_antenna.translation());
   const auto downtilt = [&](const Mat3& R) {
-    const bool off_axis = rad2deg(angle_between(R.col(2), axis_points)) > options.axis_gate_deg;
-    return boresight_downtilt(off_axis ? with_long_axis(R, axis_points) : R, up_board);
+    const KeptAxis kept = keep_axis(R.col(2), axis_points, sight, deg2rad(options.axis_gate_deg));
+    return boresight_downtilt(with_long_axis(R, kept.axis), up_board);
   };
   // The mast, where one was fitted, before the counts (mount_side.hpp: mast_side_verdict).
   const auto by_mast = [&](const Mat3& R_board_antenna) {
@@ -531,46 +540,52 @@ void decide_front_by_mount(AntennaMeasurement& m, SilhouettePick& pick, const mo
 
 // The points fix the panel's long axis (thousands of points along 1.3–2 m); the outline fixes the
 // yaw about it. Seen from below, the outline may instead slide in tilt along the line of sight
-// (the mast's and the clamps' edges beside it fit as well): when the points' axis
-// (points_long_axis) lies more than options.axis_gate_deg away, the outline is refined again
-// with the axis held to the points' and only the yaw and position free. Returns the rotation
+// (the mast's and the clamps' edges beside it fit as well): beyond the gate the outline is refined
+// again with its axis held to the one kept (keep_axis: its tilt along the line of sight the
+// points', across it the outline's own), and only the yaw and position free. Returns the rotation
 // covariance (board frame) to use, or nothing when the outline's own stands.
 std::optional<Mat3> hold_axis_to_points(AntennaMeasurement& m, Iso3& T_antenna_board, const Mat3& cov_outline,
                                         const model::AntennaModel& model, const Vec3& axis_points, const Scene& scene,
                                         const std::function<bool(const Iso3&)>& fits_points,
                                         const NonContactOptions& options) {
   const Mat3 R_outline = T_antenna_board.rotation().transpose();
-  const double disagreement = angle_between(R_outline.col(2), axis_points);
-  if (rad2deg(disagreement) <= options.axis_gate_deg) return std::nullopt;
+  const KeptAxis kept = keep_axis(R_outline.col(2), axis_points,
+                                  mean_line_of_sight(scene, T_antenna_board.inverse().translation()),
+                                  deg2rad(options.axis_gate_deg));
+  if (!kept.from_points) return std::nullopt;
 
   Iso3 start = T_antenna_board.inverse();
-  start.linear() = with_long_axis(R_outline, axis_points);
-  const Mat3& R = start.linear();
+  start.linear() = with_long_axis(R_outline, kept.axis);
   // Held: a prior far tighter than either measurement on the two rotations that move the axis.
+  // Across the line of sight the kept axis is the outline's own fit already (freed there again,
+  // 4610-2 and 4710-1 came out the same within 0.1°).
   const double held = deg2rad(0.01);
-  const registration::RotationPrior prior{R, across_long_axis(R, 1 / (held * held))};
+  const registration::RotationPrior prior{start.linear(), across_long_axis(start.linear(), 1 / (held * held))};
   const auto r = registration::refine_by_silhouette(model.mesh_antenna, start, scene.outline_views, scene.intrinsics,
                                                     options.silhouette_options, prior);
-  // The points' axis is the likelier (the development sites: within 0.43° where the outline's
+  // The points' tilt is the likelier (the development sites: within 0.43° where the outline's
   // was 4–7° off), but not always (602-1 from the ground: the points 3.2° off, the outline's
-  // right), so the downtilt and roll σ cover both, as a two-way mixture: half the disagreement.
+  // right), so its σ covers both, as a two-way mixture: half the difference. Across the line of
+  // sight the σ is the outline's free fit's.
   const double sa = deg2rad(options.points_axis_sigma_deg);
-  const Mat3 both = across_long_axis(R, sa * sa + std::pow(disagreement / 2, 2));
+  const Mat3 both = (sa * sa + std::pow(kept.along_rad / 2, 2)) * kept.about * kept.about.transpose() +
+                    kept.sideways.dot(cov_outline * kept.sideways) * kept.sideways * kept.sideways.transpose();
+  const std::string disagreement =
+      fmt::format("the outline's long axis lay {:.1f}° from the points' ({:+.1f}° along the line of sight, where seen "
+                  "from below it can slide)",
+                  rad2deg(kept.disagreement_rad), rad2deg(kept.along_rad));
   if (r.converged && fits_points(r.T_board_antenna.inverse())) {
-    m.warnings.push_back(fmt::format(
-        "the outline's long axis lay {:.1f}° from the points' (seen from below it can slide along the line of "
-        "sight): the points' axis is kept, the outline fixes the yaw about it, and the downtilt and roll σ cover "
-        "both axes",
-        rad2deg(disagreement)));
+    m.warnings.push_back(disagreement +
+                         ": the points' tilt along the line of sight is kept, the outline fixes the rest, and the "
+                         "downtilt and roll σ cover both");
     T_antenna_board = r.T_board_antenna.inverse();
     return Mat3(r.covariance.topLeftCorner<3, 3>() + both);
   }
-  m.warnings.push_back(fmt::format(
-      "the outline's long axis lies {:.1f}° from the points', and the outline does not fit with the points' axis: "
-      "the points' axis is kept, and the downtilt and roll σ cover both",
-      rad2deg(disagreement)));
+  m.warnings.push_back(disagreement +
+                       ", and the outline does not fit with the points' tilt: that tilt is kept, and the downtilt "
+                       "and roll σ cover both");
   T_antenna_board = start.inverse();
-  return Mat3(cov_outline + both);
+  return Mat3(cov_outline + (sa * sa + std::pow(kept.along_rad / 2, 2)) * kept.about * kept.about.transpose());
 }
 
 // The outline's score along the yaw about a held long axis, the position refit at each yaw
@@ -924,7 +939,7 @@ OutlineFit fit_outline(AntennaMeasurement& m, const model::AntennaModel& model, 
   const Vec3 axis_points =
       held_axis ? *held_axis
                 : points_long_axis(points.cloud, points.model, pick.best->T_board_antenna.inverse(), options);
-  decide_front_by_mount(m, pick, model, points.model, axis_points, points.reach_m, scene.up_board, options);
+  decide_front_by_mount(m, pick, model, points.model, axis_points, points.reach_m, scene, options);
   OutlineFit fit{pick.best->T_board_antenna.inverse(), pick.best->covariance.topLeftCorner<3, 3>(), pick.rivals};
   if (held_axis) {
     // The yaw's σ: a uniform spread over the bounded range (half-width h: h/√3).
@@ -947,14 +962,17 @@ OutlineFit fit_outline(AntennaMeasurement& m, const model::AntennaModel& model, 
           rad2deg(disagreement)));
     m.warnings.push_back(fmt::format(
         "the outline fitted {} with its long axis free; it fitted {}with the points' axis held, so the downtilt and "
-        "roll are the points' and the outline fixes the yaw about their axis, within {}{:+.0f}° to {:+.0f}° of the "
-        "result (a narrow panel's outline barely changes with yaw when seen face-on from below: photograph it over "
-        "a wider arc or from nearer)",
+        "roll are the points' and the outline fixes the yaw about their axis, {} (a narrow panel's outline barely "
+        "changes with yaw when seen face-on from below: photograph it over a wider arc or from nearer)",
         !free_score      ? std::string("from no start")
         : free_rival_yaw ? fmt::format("ambiguously (score {:.2f}, and another yaw about as well)", *free_score)
                          : fmt::format("poorly (score {:.2f})", *free_score),
         free_score ? fmt::format("about as well or better ({:.2f}) ", pick.best->score) : std::string(),
-        profile.open ? "more than " : "", rad2deg(profile.low_rad), rad2deg(profile.high_rad)));
+        // Where no other step of the profile scores within the margin, the yaw is fixed to less than a step.
+        profile.high_rad > profile.low_rad
+            ? fmt::format("within {}{:+.0f}° to {:+.0f}° of the result", profile.open ? "more than " : "",
+                          rad2deg(profile.low_rad), rad2deg(profile.high_rad))
+            : fmt::format("to within its profile's {:.0f}° step", options.held_yaw_step_deg)));
   }
   m.silhouette_rms_px = pick.best->rms_px;
   m.method = fmt::format("model {}, points + outline in {} photos", model.name, pick.best->views_used);

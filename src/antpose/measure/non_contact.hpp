@@ -157,12 +157,13 @@ struct NonContactOptions {
   double outline_points_fit_ratio = 0.6;
   double rival_min_deg = 10.0;  // another hypothesis this far in boresight, scoring within the
                                 // ambiguity margin, is a rival (AntennaMeasurement::rivals_board)
-  /// The outline against the points' long axis (hold_axis_to_points in non_contact.cpp): beyond
-  /// the gate the points' axis is kept, with points_axis_sigma_deg per axis and half the
-  /// disagreement (either may be the wrong one: 602-1 the points 3.2° off). The outline's axis
-  /// was 4–7° off where it failed (development sites 602–612); from the ground, 20–30 m away, the
-  /// points' own axis was 1.1–2.0° off where the outline's was right within 0.2° (sites 710-1,
-  /// 712-2, 802, 810-1), so smaller disagreements keep the outline's.
+  /// The outline against the points' long axis (hold_axis_to_points in non_contact.cpp, and
+  /// long_axis.hpp): beyond the gate the points' tilt along the line of sight is kept, with
+  /// points_axis_sigma_deg and half the difference (either may be the wrong one: 602-1 the
+  /// points 3.2° off). The outline's axis was 4–7° off where it failed (development sites
+  /// 602–612); from the ground, 20–30 m away, the points' own axis was 1.1–2.0° off where the
+  /// outline's was right within 0.2° (sites 710-1, 712-2, 802, 810-1), so smaller disagreements
+  /// keep the outline's.
   double axis_gate_deg = 3.0;
   /// The board hides what lies behind it and is not the antenna: the outline is not sought on
   /// it, nor region points taken from it, within its printed extent plus this white margin
