@@ -568,8 +568,7 @@ std::optional<Mat3> hold_axis_to_points(AntennaMeasurement& m, Iso3& T_antenna_b
   // right), so its σ covers both, as a two-way mixture: half the difference. Across the line of
   // sight the σ is the outline's free fit's.
   const double sa = deg2rad(options.points_axis_sigma_deg);
-  const Mat3 both = (sa * sa + std::pow(kept.along_rad / 2, 2)) * kept.about * kept.about.transpose() +
-                    kept.sideways.dot(cov_outline * kept.sideways) * kept.sideways * kept.sideways.transpose();
+  const Mat3 along = (sa * sa + std::pow(kept.along_rad / 2, 2)) * kept.about * kept.about.transpose();
   const std::string disagreement =
       fmt::format("the outline's long axis lay {:.1f}° from the points' ({:+.1f}° along the line of sight, where seen "
                   "from below it can slide)",
@@ -579,13 +578,15 @@ std::optional<Mat3> hold_axis_to_points(AntennaMeasurement& m, Iso3& T_antenna_b
                          ": the points' tilt along the line of sight is kept, the outline fixes the rest, and the "
                          "downtilt and roll σ cover both");
     T_antenna_board = r.T_board_antenna.inverse();
-    return Mat3(r.covariance.topLeftCorner<3, 3>() + both);
+    const Mat3 across =
+        kept.sideways.dot(cov_outline * kept.sideways) * kept.sideways * kept.sideways.transpose();
+    return Mat3(r.covariance.topLeftCorner<3, 3>() + along + across);
   }
   m.warnings.push_back(disagreement +
                        ", and the outline does not fit with the points' tilt: that tilt is kept, and the downtilt "
                        "and roll σ cover both");
   T_antenna_board = start.inverse();
-  return Mat3(cov_outline + (sa * sa + std::pow(kept.along_rad / 2, 2)) * kept.about * kept.about.transpose());
+  return Mat3(cov_outline + along);
 }
 
 // The outline's score along the yaw about a held long axis, the position refit at each yaw
