@@ -155,5 +155,24 @@ TEST(Sampling, VisibleSurfaceIsOccluded) {
   EXPECT_NEAR(around * 0.02 * 0.02, 1.0 - 0.25 * std::pow(102.5 / 99.75, 2), 0.03);
 }
 
+// From several viewpoints: each sample once, those any of them sees (front and back here, which
+// share no sample), in the full sample's order.
+TEST(Sampling, VisibleFromSeveralViewpointsIsTheUnion) {
+  const Mesh panel = parametric_panel(PanelSpec{}).mesh_antenna;
+  const Vec3 front(0, 100, 0), back(0, -100, 0);
+  const PointCloud seen_front = visible_surface(panel, front, 0.01, 5);
+  const PointCloud seen_back = visible_surface(panel, back, 0.01, 5);
+  const PointCloud both = visible_surface(panel, std::vector<Vec3>{front, back, front}, 0.01, 5);
+  ASSERT_EQ(both.size(), seen_front.size() + seen_back.size());
+  std::size_t f = 0, b = 0;
+  for (const auto& p : both.points) {
+    if (f < seen_front.size() && p == seen_front.points[f])
+      ++f;
+    else
+      ASSERT_EQ(p, seen_back.points[b++]);
+  }
+  EXPECT_TRUE(visible_surface(panel, std::vector<Vec3>{}, 0.01, 5).empty());
+}
+
 }  // namespace
 }  // namespace antpose::model

@@ -412,10 +412,43 @@ SilhouettePick silhouette_search(const model::AntennaModel& model, const Iso3& T
   return pick;
 }
 
-// The points' long axis (board frame, pointing as R_board_antenna's z): ICP from T_antenna_board.
-// Thousands of points along 1.3–2 m fix it where the outline may slide (hold_axis_to_points).
-Vec3 points_long_axis(const registration::PreparedCloud& cloud, const registration::PreparedCloud& model_prepared,
-                      const Iso3& T_antenna_board, const NonContactOptions& options) {
+// The region's points against the part of the model the photos can have seen from
+// T_antenna_board (model::visible_surface from the scene's camera centres), by ICP with the yaw
+// about the long axis held. The back plate and the brackets, which no photo of the front sees,
+// pair with the mast and arms behind the panel and lean the axis towards them: on 4906-1 (a
+// thesis panel seen face-on from 23 m) the whole model leant 0.80° along the line of sight from
+// the true pose, its seen part 0.26°; on 4710-1 1.35° and 0.68°. And a face-on panel's front is
+// too narrow for its points to fix the yaw: free, the whole model slid 32° from the truth.
+struct SeenFit {
+  Vec3 axis_board = Vec3::UnitZ();  // the long axis, pointing as T_antenna_board's z
+  double fitness = 0.0;             // share of the region's points within reach of the seen part
+};
+
+SeenFit fit_seen_surface(const registration::PreparedCloud& cloud, const model::AntennaModel& model,
+                         const Iso3& T_antenna_board, const Scene& scene, const NonContactOptions& options) {
+  std::vector<Vec3> viewpoints_antenna;
+  for (const Vec3& c : scene.viewpoints) viewpoints_antenna.push_back(T_antenna_board * c);
+  auto o = options.registration.fine;
+  o.held_rotation_axis = Vec3::UnitZ();
+  auto seen = model::visible_surface(model.mesh_antenna, viewpoints_antenna, options.model_spacing_m, options.seed);
+  if (seen.empty()) throw MeasurementError("no camera sees the model's surface from the registered pose");
+  const auto icp = registration::align(cloud, registration::prepare(std::move(seen), o), T_antenna_board, o);
+  const Vec3 axis = icp.T_target_source.rotation().transpose().col(2);
+  return {axis.dot(T_antenna_board.rotation().row(2).transpose()) < 0.0 ? Vec3(-axis) : axis, icp.fitness};
+}
+
+// The points' long axis (board frame, pointing as R_board_antenna's z) where the outline has
+// fixed the yaw: fit_seen_surface's. Thousands of points along 1.3–2 m fix it where the outline
+// may slide (hold_axis_to_points).
+Vec3 points_long_axis(const registration::PreparedCloud& cloud, const model::AntennaModel& model,
+                      const Iso3& T_antenna_board, const Scene& scene, const NonContactOptions& options) {
+  return fit_seen_surface(cloud, model, T_antenna_board, scene, options).axis_board;
+}
+
+// The same from the points' own pose, whose yaw may be tens of degrees off (then the part of the
+// model the photos see is another part): ICP with the whole model.
+Vec3 whole_model_long_axis(const registration::PreparedCloud& cloud, const registration::PreparedCloud& model_prepared,
+                           const Iso3& T_antenna_board, const NonContactOptions& options) {
   const auto icp = registration::align(cloud, model_prepared, T_antenna_board, options.registration.fine);
   const Vec3 axis = icp.T_target_source.rotation().transpose().col(2);
   return axis.dot(T_antenna_board.rotation().row(2).transpose()) < 0.0 ? Vec3(-axis) : axis;
@@ -549,9 +582,9 @@ std::optional<Mat3> hold_axis_to_points(AntennaMeasurement& m, Iso3& T_antenna_b
                                         const std::function<bool(const Iso3&)>& fits_points,
                                         const NonContactOptions& options) {
   const Mat3 R_outline = T_antenna_board.rotation().transpose();
-  const KeptAxis kept = keep_axis(R_outline.col(2), axis_points,
-                                  mean_line_of_sight(scene, T_antenna_board.inverse().translation()),
-                                  deg2rad(options.axis_gate_deg));
+  const KeptAxis kept =
+      keep_axis(R_outline.col(2), axis_points, mean_line_of_sight(scene, T_antenna_board.inverse().translation()),
+                deg2rad(options.axis_gate_deg));
   if (!kept.from_points) return std::nullopt;
 
   Iso3 start = T_antenna_board.inverse();
@@ -569,17 +602,16 @@ std::optional<Mat3> hold_axis_to_points(AntennaMeasurement& m, Iso3& T_antenna_b
   // sight the σ is the outline's free fit's.
   const double sa = deg2rad(options.points_axis_sigma_deg);
   const Mat3 along = (sa * sa + std::pow(kept.along_rad / 2, 2)) * kept.about * kept.about.transpose();
-  const std::string disagreement =
-      fmt::format("the outline's long axis lay {:.1f}° from the points' ({:+.1f}° along the line of sight, where seen "
-                  "from below it can slide)",
-                  rad2deg(kept.disagreement_rad), rad2deg(kept.along_rad));
+  const std::string disagreement = fmt::format(
+      "the outline's long axis lay {:.1f}° from the points' ({:+.1f}° along the line of sight, where seen "
+      "from below it can slide)",
+      rad2deg(kept.disagreement_rad), rad2deg(kept.along_rad));
   if (r.converged && fits_points(r.T_board_antenna.inverse())) {
     m.warnings.push_back(disagreement +
                          ": the points' tilt along the line of sight is kept, the outline fixes the rest, and the "
                          "downtilt and roll σ cover both");
     T_antenna_board = r.T_board_antenna.inverse();
-    const Mat3 across =
-        kept.sideways.dot(cov_outline * kept.sideways) * kept.sideways * kept.sideways.transpose();
+    const Mat3 across = kept.sideways.dot(cov_outline * kept.sideways) * kept.sideways * kept.sideways.transpose();
     return Mat3(r.covariance.topLeftCorner<3, 3>() + along + across);
   }
   m.warnings.push_back(disagreement +
@@ -594,11 +626,21 @@ std::optional<Mat3> hold_axis_to_points(AntennaMeasurement& m, Iso3& T_antenna_b
 // outline little with yaw, and the mast's and the clamps' edges beside it shift the minimum:
 // on the development sites the descents stopped 7° from the profile's minimum (604-1), and the
 // truth scored up to 0.042 above it (1102-1, 1402-1). So the minimum is taken, and the yaws
-// scoring within options.held_yaw_margin of it bound the yaw.
-struct YawProfile {
-  Iso3 T_board_antenna;              // at the profile's minimum
-  double low_rad = 0, high_rad = 0;  // the bounded range, from the minimum
+// scoring within options.held_yaw_margin of it bound the yaw (a basin).
+// A box's apparent width w|cos θ| + d|sin θ| (θ the view's angle from its front) is the same at
+// θ and 2·atan(d/w) − θ, so a panel seen from one side has a second outline minimum that far
+// round: on 4906-1 (thesis panel, seen 3–13° off its front from 23 m) the truth's basin, 38°
+// from the profile's minimum, scored 0.0669 against 0.0653. Another basin whose minimum scores
+// within options.silhouette_rival_margin is kept for the points to judge (fit_outline).
+struct YawBasin {
+  Iso3 T_board_antenna;              // at the basin's minimum, refined between the steps
+  double low_rad = 0, high_rad = 0;  // its yaws within the margin, from the minimum
   bool open = false;                 // the range reaches the profile's end: the yaw is not bounded
+};
+
+struct YawProfile {
+  YawBasin best;
+  std::optional<YawBasin> other;
 };
 
 YawProfile profile_yaw(const model::AntennaModel& model, const Iso3& T_board_antenna, const Scene& scene,
@@ -620,17 +662,39 @@ YawProfile profile_yaw(const model::AntennaModel& model, const Iso3& T_board_ant
     scores.push_back(r.score);
     poses.push_back(r.T_board_antenna);
   }
-  const auto best = static_cast<std::size_t>(std::min_element(scores.begin(), scores.end()) - scores.begin());
-  std::size_t lo = best, hi = best;
-  const double limit = scores[best] + options.held_yaw_margin;
-  while (lo > 0 && scores[lo - 1] <= limit) --lo;
-  while (hi + 1 < scores.size() && scores[hi + 1] <= limit) ++hi;
-  YawProfile profile{poses[best], yaws[lo] - yaws[best], yaws[hi] - yaws[best], lo == 0 || hi + 1 == scores.size()};
-  // Between the steps: the yaw freed again from the best of them.
-  o = held_axis_descent(options);
-  o.rival_yaw_offsets_rad.clear();
-  const auto r = refine_holding_axis(model, poses[best], axis, scene, o);
-  if (r.score <= scores[best]) profile.T_board_antenna = r.T_board_antenna;
+  // The steps about step i scoring within the margin of it, not reaching into `other`'s.
+  struct Steps {
+    std::ptrdiff_t lo = 0, hi = -1;
+    bool holds(std::ptrdiff_t k) const { return lo <= k && k <= hi; }
+  };
+  const auto last = static_cast<std::ptrdiff_t>(scores.size()) - 1;
+  const auto steps_about = [&](std::ptrdiff_t i, const Steps& other) {
+    const double limit = scores[i] + options.held_yaw_margin;
+    Steps s{i, i};
+    while (s.lo > 0 && scores[s.lo - 1] <= limit && !other.holds(s.lo - 1)) --s.lo;
+    while (s.hi < last && scores[s.hi + 1] <= limit && !other.holds(s.hi + 1)) ++s.hi;
+    return s;
+  };
+  auto between = held_axis_descent(options);
+  between.rival_yaw_offsets_rad.clear();
+  const auto basin = [&](std::ptrdiff_t i, const Steps& s) {
+    YawBasin b{poses[i], yaws[s.lo] - yaws[i], yaws[s.hi] - yaws[i], s.lo == 0 || s.hi == last};
+    // Between the steps: the yaw freed again from the basin's best step.
+    const auto r = refine_holding_axis(model, poses[i], axis, scene, between);
+    if (r.score <= scores[i]) b.T_board_antenna = r.T_board_antenna;
+    return b;
+  };
+  const auto best = std::min_element(scores.begin(), scores.end()) - scores.begin();
+  const Steps best_steps = steps_about(best, {});
+  YawProfile profile{basin(best, best_steps), std::nullopt};
+  std::optional<std::ptrdiff_t> other;
+  for (std::ptrdiff_t k = 0; k <= last; ++k) {
+    const bool minimum = (k == 0 || scores[k] <= scores[k - 1]) && (k == last || scores[k] <= scores[k + 1]);
+    if (!best_steps.holds(k) && minimum && scores[k] <= scores[best] + options.silhouette_rival_margin &&
+        (!other || scores[k] < scores[*other]))
+      other = k;
+  }
+  if (other) profile.other = basin(*other, steps_about(*other, best_steps));
   return profile;
 }
 
@@ -839,7 +903,7 @@ OutlineSearch search_outline(const PointCloud& cloud_board, const model::Antenna
   std::optional<Vec3> axis_points;  // an ICP: run once, for the held search or the last fallback
   const auto points_axis = [&] {
     if (!axis_points) {
-      const Vec3 axis = points_long_axis(points.cloud, points.model, T_antenna_board, options);
+      const Vec3 axis = whole_model_long_axis(points.cloud, points.model, T_antenna_board, options);
       axis_points = axis.dot(site.up_board) < 0.0 ? Vec3(-axis) : axis;
     }
     return *axis_points;
@@ -939,21 +1003,46 @@ OutlineFit fit_outline(AntennaMeasurement& m, const model::AntennaModel& model, 
   // another (below).
   const Vec3 axis_points =
       held_axis ? *held_axis
-                : points_long_axis(points.cloud, points.model, pick.best->T_board_antenna.inverse(), options);
+                : points_long_axis(points.cloud, model, pick.best->T_board_antenna.inverse(), scene, options);
   decide_front_by_mount(m, pick, model, points.model, axis_points, points.reach_m, scene, options);
   OutlineFit fit{pick.best->T_board_antenna.inverse(), pick.best->covariance.topLeftCorner<3, 3>(), pick.rivals};
   if (held_axis) {
-    // The yaw's σ: a uniform spread over the bounded range (half-width h: h/√3).
     const auto profile = profile_yaw(model, pick.best->T_board_antenna, scene, options);
-    fit.T_antenna_board = profile.T_board_antenna.inverse();
-    const Mat3& R = profile.T_board_antenna.linear();
+    const YawBasin* basin = &profile.best;
+    if (profile.other) {
+      // The outline cannot tell the two basins apart: the points can, against what the photos
+      // see of the model in each.
+      const double here =
+          fit_seen_surface(points.cloud, model, profile.best.T_board_antenna.inverse(), scene, options).fitness;
+      const double there =
+          fit_seen_surface(points.cloud, model, profile.other->T_board_antenna.inverse(), scene, options).fitness;
+      const double turn = rad2deg(
+          angle_between(profile.other->T_board_antenna.linear().col(1), profile.best.T_board_antenna.linear().col(1)));
+      const bool other_wins = there > (1 + options.seen_fit_margin) * here;
+      const bool decided = other_wins || here > (1 + options.seen_fit_margin) * there;
+      if (other_wins) basin = &*profile.other;
+      if (!decided) fit.rivals_board.push_back(profile.other->T_board_antenna.linear());
+      m.warnings.push_back(fmt::format(
+          "the outline fits two yaws {:.0f}° apart about as well (a box's outline repeats either side of the view "
+          "where it looks widest); {} ({:.0f} % of the points lie near what the photos see of the model against "
+          "{:.0f} %)",
+          turn,
+          !decided     ? "the points do not tell them apart either, and the σ covers both"
+          : other_wins ? "the points fit the outline's second best clearly better, and it is kept"
+                       : "the points fit the outline's best clearly better",
+          100 * std::max(here, there), 100 * std::min(here, there)));
+    }
+    fit.T_antenna_board = basin->T_board_antenna.inverse();
+    const Mat3& R = basin->T_board_antenna.linear();
     // The points' ICP from the result's pose may settle on another axis (clutter in the region
-    // pulls it differently from another start: 1604-2, 3.5° off where the held one was 0.6°): the
-    // held axis stays, and its σ covers both, as in hold_axis_to_points.
-    const Vec3 axis_again = points_long_axis(points.cloud, points.model, fit.T_antenna_board, options);
+    // pulls it differently from another start: 1604-2, 3.5° off where the held one was 0.6°; on
+    // 4706-3, a 2 m panel seen from its side, keeping this one instead moved the downtilt from
+    // −0.02° to −1.76°): the held axis stays, and its σ covers both, as in hold_axis_to_points.
+    const Vec3 axis_again = points_long_axis(points.cloud, model, fit.T_antenna_board, scene, options);
     const double disagreement = angle_between(axis_again, R.col(2));
     const double sa = deg2rad(options.held_axis_sigma_deg);
-    const double sy = (profile.high_rad - profile.low_rad) / 2 / std::sqrt(3.0);
+    // The yaw's σ: a uniform spread over the bounded range (half-width h: h/√3).
+    const double sy = (basin->high_rad - basin->low_rad) / 2 / std::sqrt(3.0);
     fit.cov_board +=
         across_long_axis(R, sa * sa + std::pow(disagreement / 2, 2)) + sy * sy * R.col(2) * R.col(2).transpose();
     if (rad2deg(disagreement) > options.axis_gate_deg)
@@ -970,9 +1059,9 @@ OutlineFit fit_outline(AntennaMeasurement& m, const model::AntennaModel& model, 
                          : fmt::format("poorly (score {:.2f})", *free_score),
         free_score ? fmt::format("about as well or better ({:.2f}) ", pick.best->score) : std::string(),
         // Where no other step of the profile scores within the margin, the yaw is fixed to less than a step.
-        profile.high_rad > profile.low_rad
-            ? fmt::format("within {}{:+.0f}° to {:+.0f}° of the result", profile.open ? "more than " : "",
-                          rad2deg(profile.low_rad), rad2deg(profile.high_rad))
+        basin->high_rad > basin->low_rad
+            ? fmt::format("within {}{:+.0f}° to {:+.0f}° of the result", basin->open ? "more than " : "",
+                          rad2deg(basin->low_rad), rad2deg(basin->high_rad))
             : fmt::format("to within its profile's {:.0f}° step", options.held_yaw_step_deg)));
   }
   m.silhouette_rms_px = pick.best->rms_px;

@@ -1,5 +1,6 @@
 #include "antpose/model/sampling.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <stdexcept>
@@ -88,12 +89,20 @@ PointCloud sample_surface(const Mesh& mesh, double spacing_m, std::uint64_t seed
 }
 
 PointCloud visible_surface(const Mesh& mesh, const Vec3& viewpoint, double spacing_m, std::uint64_t seed) {
+  return visible_surface(mesh, std::vector<Vec3>{viewpoint}, spacing_m, seed);
+}
+
+PointCloud visible_surface(const Mesh& mesh, const std::vector<Vec3>& viewpoints, double spacing_m,
+                           std::uint64_t seed) {
   const Samples all = sample(mesh, spacing_m, seed);
   PointCloud out;
   for (std::size_t k = 0; k < all.cloud.size(); ++k) {
     const Vec3& p = all.cloud.points[k];
     const Vec3& n = all.cloud.normals[k];
-    if (n.dot(viewpoint - p) <= 0 || occluded(mesh, all.triangle[k], p, viewpoint)) continue;
+    const auto sees = [&](const Vec3& viewpoint) {
+      return n.dot(viewpoint - p) > 0 && !occluded(mesh, all.triangle[k], p, viewpoint);
+    };
+    if (std::none_of(viewpoints.begin(), viewpoints.end(), sees)) continue;
     out.points.push_back(p);
     out.normals.push_back(n);
   }

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <cstdint>
+#include <vector>
 
 #include "antpose/geometry/point_cloud.hpp"
 #include "antpose/model/mesh.hpp"
@@ -27,5 +28,9 @@ PointCloud sample_surface(const Mesh& mesh, double spacing_m, std::uint64_t seed
 /// models of a few thousand triangles (a built-in panel has a few hundred); no self-shadowing
 /// tolerance beyond floating point, so coplanar neighbours do not hide each other.
 PointCloud visible_surface(const Mesh& mesh, const Vec3& viewpoint, double spacing_m, std::uint64_t seed);
+
+/// The samples that any of `viewpoints` sees (as above; each sample once): what a photo series
+/// can have reconstructed of the model, so that points behind it (a mast, arms) find no back face.
+PointCloud visible_surface(const Mesh& mesh, const std::vector<Vec3>& viewpoints, double spacing_m, std::uint64_t seed);
 
 }  // namespace antpose::model

@@ -119,7 +119,7 @@ Sums accumulate(const PreparedCloud& source, const PreparedCloud& target, const 
 }
 
 /// The increment of one iteration (applied on the left), or nullopt when it is undetermined.
-std::optional<Iso3> increment(const Sums& s, IcpMethod method) {
+std::optional<Iso3> increment(const Sums& s, IcpMethod method, const std::optional<Vec3>& held_axis) {
   Iso3 dT = Iso3::Identity();
   if (method == IcpMethod::kPointToPoint) {
     if (s.pairs < 3 || s.w <= 0.0) return std::nullopt;
@@ -130,9 +130,21 @@ std::optional<Iso3> increment(const Sums& s, IcpMethod method) {
     return dT;
   }
   if (s.pairs < 6) return std::nullopt;
-  const Eigen::LDLT<Mat6> ldlt(s.H);
+  // Held axis: ξ = P y with P spanning the rotations across it and all translations, and the
+  // normal equations solved for y (PᵀHP y = −Pᵀg).
+  Eigen::Matrix<double, 6, Eigen::Dynamic> P = Mat6::Identity();
+  if (held_axis) {
+    const Vec3 a = held_axis->normalized(), u = a.unitOrthogonal();
+    P.resize(6, 5);
+    P.setZero();
+    P.block<3, 1>(0, 0) = u;
+    P.block<3, 1>(0, 1) = a.cross(u);
+    P.block<3, 3>(3, 2).setIdentity();
+  }
+  const Eigen::MatrixXd H = P.transpose() * s.H * P;
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(H);
   if (ldlt.info() != Eigen::Success || !ldlt.isPositive()) return std::nullopt;
-  const Vec6 xi = -ldlt.solve(s.g);
+  const Vec6 xi = -P * ldlt.solve(P.transpose() * s.g);
   if (!xi.allFinite()) return std::nullopt;
   dT.linear() = exp_so3(xi.head<3>());
   dT.translation() = xi.tail<3>();
@@ -172,11 +184,13 @@ IcpResult align(const PreparedCloud& source, const PreparedCloud& target, const 
   if (options.method == IcpMethod::kGeneralized &&
       (source.covariances.size() != source.cloud.size() || target.covariances.size() != target.cloud.size()))
     throw std::invalid_argument("generalized ICP: both clouds need covariances (use prepare())");
+  if (options.held_rotation_axis && options.method == IcpMethod::kPointToPoint)
+    throw std::invalid_argument("ICP point-to-point: a held rotation axis needs point-to-plane or generalized ICP");
   IcpResult result;
   Iso3 T = T_initial;
   for (int it = 0; it < options.max_iterations; ++it) {
     const Sums s = accumulate(source, target, T, options);
-    const auto dT = increment(s, options.method);
+    const auto dT = increment(s, options.method, options.held_rotation_axis);
     result.iterations = it + 1;
     if (!dT) break;
     T = *dT * T;

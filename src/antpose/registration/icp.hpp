@@ -15,6 +15,7 @@
 
 #include <cstddef>
 #include <limits>
+#include <optional>
 #include <vector>
 
 #include "antpose/geometry/point_cloud.hpp"
@@ -35,6 +36,11 @@ struct IcpOptions {
   std::size_t normal_k = 10;      // neighbours for normals (point-to-plane, target)
   std::size_t covariance_k = 20;  // neighbours for GICP covariances
   double gicp_epsilon = 1e-3;
+  /// Where set (a unit vector in the target frame), the increment turns about no axis along it:
+  /// the rotation about it stays the start's. Point-to-plane and generalized ICP only (their
+  /// linear step is solved on the 5-D subspace); a measurement holds a panel's yaw about its
+  /// long axis (z_a), which its points fix poorly when seen face-on, to read the axis's tilt.
+  std::optional<Vec3> held_rotation_axis;
 };
 
 /// A cloud ready for registration: its k-d tree and what the method needs (target normals for
