@@ -412,6 +412,12 @@ SilhouettePick silhouette_search(const model::AntennaModel& model, const Iso3& T
   return pick;
 }
 
+// The long axis (board frame) of a fitted T_antenna_board, pointing as `reference`'s z.
+Vec3 long_axis_board(const Iso3& T_antenna_board, const Iso3& reference) {
+  const Vec3 axis = T_antenna_board.rotation().transpose().col(2);
+  return axis.dot(reference.rotation().row(2).transpose()) < 0.0 ? Vec3(-axis) : axis;
+}
+
 // The region's points against the part of the model the photos can have seen from
 // T_antenna_board (model::visible_surface from the scene's camera centres), by ICP with the yaw
 // about the long axis held. The back plate and the brackets, which no photo of the front sees,
@@ -433,8 +439,7 @@ SeenFit fit_seen_surface(const registration::PreparedCloud& cloud, const model::
   auto seen = model::visible_surface(model.mesh_antenna, viewpoints_antenna, options.model_spacing_m, options.seed);
   if (seen.empty()) throw MeasurementError("no camera sees the model's surface from the registered pose");
   const auto icp = registration::align(cloud, registration::prepare(std::move(seen), o), T_antenna_board, o);
-  const Vec3 axis = icp.T_target_source.rotation().transpose().col(2);
-  return {axis.dot(T_antenna_board.rotation().row(2).transpose()) < 0.0 ? Vec3(-axis) : axis, icp.fitness};
+  return {long_axis_board(icp.T_target_source, T_antenna_board), icp.fitness};
 }
 
 // The points' long axis (board frame, pointing as R_board_antenna's z) where the outline has
@@ -449,9 +454,9 @@ Vec3 points_long_axis(const registration::PreparedCloud& cloud, const model::Ant
 // model the photos see is another part): ICP with the whole model.
 Vec3 whole_model_long_axis(const registration::PreparedCloud& cloud, const registration::PreparedCloud& model_prepared,
                            const Iso3& T_antenna_board, const NonContactOptions& options) {
-  const auto icp = registration::align(cloud, model_prepared, T_antenna_board, options.registration.fine);
-  const Vec3 axis = icp.T_target_source.rotation().transpose().col(2);
-  return axis.dot(T_antenna_board.rotation().row(2).transpose()) < 0.0 ? Vec3(-axis) : axis;
+  return long_axis_board(
+      registration::align(cloud, model_prepared, T_antenna_board, options.registration.fine).T_target_source,
+      T_antenna_board);
 }
 
 // The mount decides front and back where the outline cannot (mount_side.hpp: the mast where one
@@ -1009,18 +1014,21 @@ OutlineFit fit_outline(AntennaMeasurement& m, const model::AntennaModel& model, 
   if (held_axis) {
     const auto profile = profile_yaw(model, pick.best->T_board_antenna, scene, options);
     const YawBasin* basin = &profile.best;
+    const auto seen_fit = [&](const YawBasin& b) {
+      return fit_seen_surface(points.cloud, model, b.T_board_antenna.inverse(), scene, options);
+    };
+    std::optional<SeenFit> kept_seen;  // the kept basin's, where already fitted
     if (profile.other) {
       // The outline cannot tell the two basins apart: the points can, against what the photos
       // see of the model in each.
-      const double here =
-          fit_seen_surface(points.cloud, model, profile.best.T_board_antenna.inverse(), scene, options).fitness;
-      const double there =
-          fit_seen_surface(points.cloud, model, profile.other->T_board_antenna.inverse(), scene, options).fitness;
+      const SeenFit best_seen = seen_fit(profile.best), other_seen = seen_fit(*profile.other);
+      const double here = best_seen.fitness, there = other_seen.fitness;
       const double turn = rad2deg(
           angle_between(profile.other->T_board_antenna.linear().col(1), profile.best.T_board_antenna.linear().col(1)));
       const bool other_wins = there > (1 + options.seen_fit_margin) * here;
       const bool decided = other_wins || here > (1 + options.seen_fit_margin) * there;
       if (other_wins) basin = &*profile.other;
+      kept_seen = other_wins ? other_seen : best_seen;
       if (!decided) fit.rivals_board.push_back(profile.other->T_board_antenna.linear());
       m.warnings.push_back(fmt::format(
           "the outline fits two yaws {:.0f}° apart about as well (a box's outline repeats either side of the view "
@@ -1038,7 +1046,7 @@ OutlineFit fit_outline(AntennaMeasurement& m, const model::AntennaModel& model, 
     // pulls it differently from another start: 1604-2, 3.5° off where the held one was 0.6°; on
     // 4706-3, a 2 m panel seen from its side, keeping this one instead moved the downtilt from
     // −0.02° to −1.76°): the held axis stays, and its σ covers both, as in hold_axis_to_points.
-    const Vec3 axis_again = points_long_axis(points.cloud, model, fit.T_antenna_board, scene, options);
+    const Vec3 axis_again = (kept_seen ? *kept_seen : seen_fit(*basin)).axis_board;
     const double disagreement = angle_between(axis_again, R.col(2));
     const double sa = deg2rad(options.held_axis_sigma_deg);
     // The yaw's σ: a uniform spread over the bounded range (half-width h: h/√3).

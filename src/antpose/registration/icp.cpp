@@ -130,21 +130,22 @@ std::optional<Iso3> increment(const Sums& s, IcpMethod method, const std::option
     return dT;
   }
   if (s.pairs < 6) return std::nullopt;
-  // Held axis: ξ = P y with P spanning the rotations across it and all translations, and the
-  // normal equations solved for y (PᵀHP y = −Pᵀg).
-  Eigen::Matrix<double, 6, Eigen::Dynamic> P = Mat6::Identity();
-  if (held_axis) {
+  Vec6 xi;
+  if (!held_axis) {
+    const Eigen::LDLT<Mat6> ldlt(s.H);
+    if (ldlt.info() != Eigen::Success || !ldlt.isPositive()) return std::nullopt;
+    xi = -ldlt.solve(s.g);
+  } else {
+    // ξ = P y, P spanning the rotations across the axis and all translations: PᵀHP y = −Pᵀg.
     const Vec3 a = held_axis->normalized(), u = a.unitOrthogonal();
-    P.resize(6, 5);
-    P.setZero();
+    Eigen::Matrix<double, 6, 5> P = Eigen::Matrix<double, 6, 5>::Zero();
     P.block<3, 1>(0, 0) = u;
     P.block<3, 1>(0, 1) = a.cross(u);
     P.block<3, 3>(3, 2).setIdentity();
+    const Eigen::LDLT<Eigen::Matrix<double, 5, 5>> ldlt(P.transpose() * s.H * P);
+    if (ldlt.info() != Eigen::Success || !ldlt.isPositive()) return std::nullopt;
+    xi = -P * ldlt.solve(P.transpose() * s.g);
   }
-  const Eigen::MatrixXd H = P.transpose() * s.H * P;
-  const Eigen::LDLT<Eigen::MatrixXd> ldlt(H);
-  if (ldlt.info() != Eigen::Success || !ldlt.isPositive()) return std::nullopt;
-  const Vec6 xi = -P * ldlt.solve(P.transpose() * s.g);
   if (!xi.allFinite()) return std::nullopt;
   dT.linear() = exp_so3(xi.head<3>());
   dT.translation() = xi.tail<3>();
