@@ -2,6 +2,8 @@
 
 #include <random>
 
+#include <opencv2/core.hpp>
+
 #include <gtest/gtest.h>
 
 #include "reconstruction/scene_fixture.hpp"
@@ -95,6 +97,40 @@ TEST(ReconstructFeatures, EpipolarFilterKeepsTrueMatches) {
   for (const auto& [a, b] : kept) right += a == b;
   EXPECT_EQ(right, kept.size());
   EXPECT_GT(kept.size(), 70u);
+}
+
+TEST(ReconstructFeatures, GuidedMatchingFindsWhatLookAlikesHideFromTheRatioTest) {
+  auto s = synthetic(60);
+  cv::Mat base(60, 128, CV_32F), noise_a(60, 128, CV_32F), noise_b(60, 128, CV_32F);
+  cv::randn(base, 0, 1);
+  cv::randn(noise_a, 0, 0.05);
+  cv::randn(noise_b, 0, 0.05);
+  ViewFeatures& a = s.features[0];
+  ViewFeatures& b = s.features[1];
+  a.descriptors = base + noise_a;
+  b.descriptors = base + noise_b;
+  // Look-alikes of the first 30 features 200 px above them, far off their epipolar lines (the
+  // baseline is along x), as the board's corners are to one another: the plain ratio test picks
+  // them, and the epipolar filter then drops the match.
+  for (int i = 0; i < 30; ++i) {
+    const Vec2 px = b.px[i] - Vec2(0, 200);
+    b.px.push_back(px);
+    b.xy.push_back(s.K.undistort(Vec2((px.x() - s.K.cx) / s.K.fx, (px.y() - s.K.cy) / s.K.fy)));
+    b.descriptors.push_back(a.descriptors.row(i).clone());  // nearer to a's than the true one
+  }
+  // Feature 59 is not seen in b: its only candidate on the line looks nothing like it.
+  cv::randn(b.descriptors.row(59), 0, 1);
+  const Mat3 R_b_a = s.R[1] * s.R[0].transpose();
+  const Vec3 t_b_a = s.t[1] - R_b_a * s.t[0];
+
+  const auto plain = epipolar_filter(a, b, ratio_matches(a, b, 0.8), R_b_a, t_b_a, 2.0, 850);
+  EXPECT_LE(plain.size(), 29u);  // none of the 30 with look-alikes
+  const auto guided = guided_matches(a, b, R_b_a, t_b_a, 0.8, 2.0, 850);
+  std::size_t right = 0;
+  for (const auto& [i, j] : guided) right += i == j;
+  EXPECT_EQ(right, guided.size());
+  EXPECT_EQ(guided.size(), 59u);
+  for (const auto& [i, j] : guided) EXPECT_NE(i, 59);
 }
 
 // Points along the camera's axis (identity pose: depth = z), spread across 0.3 m sideways.

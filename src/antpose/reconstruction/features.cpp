@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 
 #include <Eigen/SVD>
@@ -85,10 +86,62 @@ std::vector<std::pair<int, int>> epipolar_filter(const ViewFeatures& a, const Vi
   return out;
 }
 
-std::vector<std::pair<int, int>> match_features(const ViewFeatures& a, const ViewFeatures& b, const Mat3& R_b_a,
+std::vector<std::pair<int, int>> guided_matches(const ViewFeatures& a, const ViewFeatures& b, const Mat3& R_b_a,
                                                 const Vec3& t_b_a, double ratio, double max_epipolar_px,
-                                                double focal_px) {
-  return epipolar_filter(a, b, ratio_matches(a, b, ratio), R_b_a, t_b_a, max_epipolar_px, focal_px);
+                                                double focal_px, double max_descriptor_angle_rad) {
+  const int na = int(a.xy.size()), nb = int(b.xy.size());
+  std::vector<std::pair<int, int>> out;
+  if (na == 0 || nb == 0) return out;
+  const Mat3 E = skew(t_b_a) * R_b_a;
+  const double limit = max_epipolar_px / focal_px;
+  // Unit descriptors, so that distances compare with the angle cap (OpenCV scales SIFT's to ~512).
+  auto unit = [](const cv::Mat& d) {
+    using Rows = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+    Rows m = Eigen::Map<const Rows>(d.ptr<float>(), d.rows, d.cols);
+    m.rowwise().normalize();
+    return m;
+  };
+  const auto da = unit(a.descriptors), db = unit(b.descriptors);
+  std::vector<Vec3> line_b(na), line_a(nb);  // epipolar lines: of a's features in b, of b's in a
+  std::vector<Vec3> xa(na), xb(nb);
+  for (int i = 0; i < na; ++i) {
+    xa[i] = Vec3(a.xy[i].x(), a.xy[i].y(), 1.0);
+    line_b[i] = E * xa[i];
+  }
+  for (int j = 0; j < nb; ++j) {
+    xb[j] = Vec3(b.xy[j].x(), b.xy[j].y(), 1.0);
+    line_a[j] = E.transpose() * xb[j];
+  }
+  struct Nearest {
+    float first = std::numeric_limits<float>::infinity(), second = first;
+    int index = -1;
+    void add(float d, int k) {
+      if (d < first) {
+        second = first, first = d, index = k;
+      } else if (d < second) {
+        second = d;
+      }
+    }
+  };
+  std::vector<Nearest> of_a(na), of_b(nb);
+  for (int i = 0; i < na; ++i) {
+    const double norm_b = line_b[i].head<2>().norm();
+    for (int j = 0; j < nb; ++j) {
+      const double r = std::abs(xb[j].dot(line_b[i]));
+      if (r > limit * norm_b || r > limit * line_a[j].head<2>().norm()) continue;
+      const float d = (da.row(i) - db.row(j)).norm();
+      of_a[i].add(d, j);
+      of_b[j].add(d, i);
+    }
+  }
+  // Chord length of the angle cap between unit vectors.
+  const float max_distance = float(2.0 * std::sin(0.5 * max_descriptor_angle_rad));
+  for (int i = 0; i < na; ++i) {
+    const Nearest& n = of_a[i];
+    if (n.index < 0 || n.first > max_distance || n.first > float(ratio) * n.second) continue;
+    if (of_b[n.index].index == i) out.emplace_back(i, n.index);
+  }
+  return out;
 }
 
 namespace {

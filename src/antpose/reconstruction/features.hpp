@@ -3,7 +3,8 @@
 //   detect       SIFT (Lowe, IJCV 2004) in an image area, optionally downscaled, keypoints in
 //                full-resolution px and undistorted normalised coordinates;
 //   match        Lowe's ratio test, then the epipolar constraint of the known relative pose
-//                (symmetric distance to the epipolar lines in undistorted coordinates);
+//                (symmetric distance to the epipolar lines in undistorted coordinates); or
+//                guided: the ratio test among the candidates on the epipolar lines only;
 //   tracks       pairwise matches chained by union-find; a track with two features of one view
 //                is dropped (an ambiguous chain);
 //   triangulate  linear multi-view DLT (Hartley & Zisserman 2nd ed. §12.2) in normalised
@@ -48,12 +49,17 @@ std::vector<std::pair<int, int>> epipolar_filter(const ViewFeatures& a, const Vi
                                                  const std::vector<std::pair<int, int>>& candidates, const Mat3& R_b_a,
                                                  const Vec3& t_b_a, double max_epipolar_px, double focal_px);
 
-/// ratio_matches then epipolar_filter: index pairs passing the ratio test and lying within
-/// `max_epipolar_px` (converted with the focal length) of the epipolar lines of the pose
-/// p_b = R_b_a p_a + t_b_a.
-std::vector<std::pair<int, int>> match_features(const ViewFeatures& a, const ViewFeatures& b, const Mat3& R_b_a,
+/// Guided matching with a known relative pose p_b = R_b_a p_a + t_b_a (Hartley & Zisserman 2nd
+/// ed. §11.6, algorithm 11.4 step v): a feature's candidates are only the features of b within
+/// `max_epipolar_px` (converted with the focal length) of its epipolar lines, and Lowe's ratio
+/// test compares its two nearest descriptors among those, so that a weak feature of a plain
+/// radome is not outvoted by look-alikes elsewhere in the image (the board's corners, the
+/// ground). A match must be mutual (each the other's nearest candidate); a lone candidate passes
+/// the ratio test but must lie within `max_descriptor_angle_rad` of the feature (angle between
+/// descriptors).
+std::vector<std::pair<int, int>> guided_matches(const ViewFeatures& a, const ViewFeatures& b, const Mat3& R_b_a,
                                                 const Vec3& t_b_a, double ratio, double max_epipolar_px,
-                                                double focal_px);
+                                                double focal_px, double max_descriptor_angle_rad = 0.7);
 
 /// One observation: (view, feature index).
 using Observation = std::pair<int, int>;

@@ -1,7 +1,8 @@
 // reconstruct_region: the user's rectangle → per-view regions → points of the object.
 //
-//   1. Sparse: SIFT inside the ROI of the reference view, matched with the other views under the
-//      epipolar constraint of the refined poses, triangulated (features.hpp). The nearest cluster
+//   1. Sparse: SIFT inside the ROI of the reference view, matched with the other views by guided
+//      matching on the epipolar lines of the refined poses (a plain radome's few features are
+//      not outvoted by the board's corners and the ground elsewhere), triangulated (features.hpp). The nearest cluster
 //      of their depths (along the reference camera's axis) is the object's depth range: the
 //      background (sky, ground, buildings) of a rectangle drawn around an antenna lies behind it.
 //   2. The ROI's frustum cut to that depth range is a 3-D volume; its projection is the region
@@ -482,7 +483,7 @@ RegionReconstruction reconstruct_beyond(const std::vector<PosedView>& views, con
       const Mat3 R_b_a = R * Rr.transpose();
       const Vec3 t_b_a = t - R_b_a * tr;
       const double tol = 2.0 / std::min({1.0, features[roi_view].scale, features[v].scale});
-      pairs[k].matches = detail::match_features(features[roi_view], features[v], R_b_a, t_b_a, 0.8, tol, focal);
+      pairs[k].matches = detail::guided_matches(features[roi_view], features[v], R_b_a, t_b_a, 0.8, tol, focal);
     }
   });
   std::vector<std::size_t> counts(n);
