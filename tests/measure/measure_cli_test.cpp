@@ -81,6 +81,28 @@ TEST_F(MeasureCli, RoiOnTheSkyFailsThatAntennaWithItsReason) {
   EXPECT_THAT(j["antennas"][0]["error"].get<std::string>(), HasSubstr("no texture or object in the region"));
 }
 
+TEST_F(MeasureCli, ARectangleTheAntennaFillsLittleOfIsNamed) {
+  // The antenna's own rectangle, then one 1.8 times as wide and tall about it: the registered
+  // antenna covers about a third of that, and another object may have been taken for it.
+  int x = 0, y = 0, w = 0, h = 0;
+  ASSERT_EQ(std::sscanf(roi_.substr(roi_image_.size() + 1).c_str(), "%d,%d,%d,%d", &x, &y, &w, &h), 4);
+  const auto tight = *dir_ / "tight.json";
+  test::run_cli(measure(capture(), fmt::format("--model {} --roi {} --json '{}'", model_, roi_, tight.string())));
+  const auto warnings_of = [](const fs::path& json) {
+    const auto a = nlohmann::json::parse(io::read_text(json))["antennas"][0];
+    EXPECT_TRUE(a["error"].is_null()) << a["error"];
+    return a["warnings"].dump();
+  };
+  EXPECT_THAT(warnings_of(tight), ::testing::Not(HasSubstr("of the rectangle")));
+
+  const int x0 = std::max(0, x - 2 * w / 5), y0 = std::max(0, y - 2 * h / 5);
+  const int x1 = std::min(960, x + 7 * w / 5), y1 = std::min(720, y + 7 * h / 5);
+  const auto loose = *dir_ / "loose.json";
+  test::run_cli(measure(capture(), fmt::format("--model {} --roi {}:{},{},{},{} --json '{}'", model_, roi_image_, x0,
+                                               y0, x1 - x0, y1 - y0, loose.string())));
+  EXPECT_THAT(warnings_of(loose), HasSubstr("of the rectangle in"));
+}
+
 TEST_F(MeasureCli, PhotosWithoutTheBoardAreNamedAndLeftOut) {
   const auto cap = copy("no-board");
   // Two photos lose the board (a grey frame of the same size).

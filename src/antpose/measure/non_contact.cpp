@@ -7,6 +7,7 @@
 #include <random>
 #include <tuple>
 
+#include <Eigen/Geometry>
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 #include <nlohmann/json.hpp>
@@ -130,6 +131,24 @@ std::vector<cv::Point2f> board_outline(const std::pair<Vec3, Vec3>& box, const c
     poly.emplace_back(static_cast<float>(uv->x()), static_cast<float>(uv->y()));
   }
   return poly;
+}
+
+// Share of the rectangle in its photo that the registered antenna's box covers: the bounding box
+// of the box's projected corners, cut to the rectangle. 0 when a corner is behind the camera.
+double roi_fill(const AntennaMeasurement& m, const Vec3& size_m, const PosedView& view,
+                const camera::CameraIntrinsics& K) {
+  Eigen::AlignedBox2d box;
+  for (int c = 0; c < 8; ++c) {
+    const Vec3 corner_antenna = 0.5 * size_m.cwiseProduct(Vec3(c & 1 ? 1 : -1, c & 2 ? 1 : -1, c & 4 ? 1 : -1));
+    const auto uv = K.project(view.R_camera_board * (m.R_board_antenna * corner_antenna + m.p_board_antenna) +
+                              view.t_camera_board);
+    if (!uv) return 0.0;
+    box.extend(*uv);
+  }
+  const auto& r = m.roi.roi;
+  const Eigen::AlignedBox2d rect(Vec2(r.x - 0.5, r.y - 0.5), Vec2(r.x + r.width - 0.5, r.y + r.height - 0.5));
+  const Eigen::AlignedBox2d cut = box.intersection(rect);
+  return cut.isEmpty() ? 0.0 : cut.volume() / rect.volume();
 }
 
 // R diag(variance, variance, 0) Rᵀ: a covariance (or information) on the two rotations that move
@@ -1358,6 +1377,12 @@ NonContactResult measure_non_contact(const Capture& capture, const NonContactSet
       if (const auto* model = setup.model_for(k)) {
         points = register_points(m.region.cloud_board, *model, scene, options);
         register_model(m, *model, *points, scene, options);
+        if (const double fill = roi_fill(m, model->size_m, views[view], setup.intrinsics); fill < options.min_roi_fill)
+          m.warnings.push_back(fmt::format(
+              "the registered antenna covers only {:.0f} % of the rectangle in {}: another object (a nearer antenna?) "
+              "may have been measured, or the rectangle is not drawn tightly around the antenna; check the model "
+              "drawn over the photos",
+              100 * fill, views[view].name));
       } else {
         const FaceFit fit = fit_front_face(m.region.cloud_board, scene.viewpoints, scene.up_board, options.model_free);
         m.method = "model-free (front face + long axis)";
