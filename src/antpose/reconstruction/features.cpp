@@ -102,15 +102,17 @@ std::vector<std::pair<int, int>> guided_matches(const ViewFeatures& a, const Vie
     return m;
   };
   const auto da = unit(a.descriptors), db = unit(b.descriptors);
-  std::vector<Vec3> line_b(na), line_a(nb);  // epipolar lines: of a's features in b, of b's in a
-  std::vector<Vec3> xa(na), xb(nb);
+  // Epipolar lines of a's features in b, and the lengths of their normals and of b's lines in a
+  // (the symmetric distance's denominators), outside the na × nb loop.
+  std::vector<Vec3> line_b(na), xb(nb);
+  std::vector<double> norm_b(na), norm_a(nb);
   for (int i = 0; i < na; ++i) {
-    xa[i] = Vec3(a.xy[i].x(), a.xy[i].y(), 1.0);
-    line_b[i] = E * xa[i];
+    line_b[i] = E * Vec3(a.xy[i].x(), a.xy[i].y(), 1.0);
+    norm_b[i] = line_b[i].head<2>().norm();
   }
   for (int j = 0; j < nb; ++j) {
     xb[j] = Vec3(b.xy[j].x(), b.xy[j].y(), 1.0);
-    line_a[j] = E.transpose() * xb[j];
+    norm_a[j] = (E.transpose() * xb[j]).head<2>().norm();
   }
   struct Nearest {
     float first = std::numeric_limits<float>::infinity(), second = first;
@@ -125,10 +127,9 @@ std::vector<std::pair<int, int>> guided_matches(const ViewFeatures& a, const Vie
   };
   std::vector<Nearest> of_a(na), of_b(nb);
   for (int i = 0; i < na; ++i) {
-    const double norm_b = line_b[i].head<2>().norm();
     for (int j = 0; j < nb; ++j) {
       const double r = std::abs(xb[j].dot(line_b[i]));
-      if (r > limit * norm_b || r > limit * line_a[j].head<2>().norm()) continue;
+      if (r > limit * norm_b[i] || r > limit * norm_a[j]) continue;
       const float d = (da.row(i) - db.row(j)).norm();
       of_a[i].add(d, j);
       of_b[j].add(d, i);
