@@ -138,8 +138,7 @@ std::vector<cv::Point2f> board_outline(const std::pair<Vec3, Vec3>& box, const c
 double roi_fill(const AntennaMeasurement& m, const Vec3& size_m, const PosedView& view,
                 const camera::CameraIntrinsics& K) {
   Eigen::AlignedBox2d box;
-  for (int c = 0; c < 8; ++c) {
-    const Vec3 corner_antenna = 0.5 * size_m.cwiseProduct(Vec3(c & 1 ? 1 : -1, c & 2 ? 1 : -1, c & 4 ? 1 : -1));
+  for (const Vec3& corner_antenna : model::box_corners(size_m)) {
     const auto uv = K.project(view.R_camera_board * (m.R_board_antenna * corner_antenna + m.p_board_antenna) +
                               view.t_camera_board);
     if (!uv) return 0.0;
