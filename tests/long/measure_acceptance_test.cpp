@@ -90,7 +90,9 @@ TEST(MeasureAcceptance, SimulatedSitesThroughTheCommandLine) {
   // thesis panels on a rooftop was refused: the points' box sat 0.12 m along its axis from it
   // (other_positions); 3802 (base 3801, k = 1), whose lone 2 m panel from the ground came out
   // 1.42° off in downtilt with σ 0.36°: false feature tracks had turned every camera by
-  // 0.03–0.10° (PoseRefinementOptions::max_board_rms_growth).
+  // 0.03–0.10° (PoseRefinementOptions::max_board_rms_growth); 5111 (base 5101, k = 10), whose
+  // third panel's rectangle held the lower half of the nearer middle panel, measured for it 112°
+  // off in azimuth and 1.79° in downtilt with σ 0.24° (NonContactOptions::min_roi_fill).
   struct Site {
     int seed;
     bool ground, disturbance;
@@ -106,6 +108,7 @@ TEST(MeasureAcceptance, SimulatedSitesThroughTheCommandLine) {
     sites.push_back({3711, false, false, 3, true});
     sites.push_back({3811, false, false, 3, true});
     sites.push_back({3802, true, false, 1, true});
+    sites.push_back({5111, false, false, 3, true});
   }
   for (std::size_t k = 0; k < sites.size(); ++k) {
     const auto [seed, ground, disturbance, antennas, regression] = sites[k];

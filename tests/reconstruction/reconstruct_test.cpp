@@ -399,6 +399,33 @@ TEST(ReconstructRegion, ExcludedBoxHoldsNoPoints) {
   EXPECT_LT(half.cloud_board.size(), all.cloud_board.size() * 3 / 4);
 }
 
+// RegionOptions::beyond_m set to a result's far depth gives the object behind it (measure asks
+// for it where the registered antenna fills little of the rectangle: a nearer panel crossed it).
+TEST(ReconstructRegion, BeyondTheFirstObjectLiesTheNext) {
+  const Scene& s = textured_scene();
+  const auto poses = true_poses(s);
+  // The antenna's rectangle reaching as far again to either side, over the wall 9 m away.
+  auto roi = test::antenna_roi(s, 2);
+  roi.x = std::max(0, roi.x - roi.width);
+  roi.width = std::min(3 * roi.width, s.K.width - roi.x);
+  const auto first = reconstruct_region(s.views, poses, 2, roi, s.K, {});
+  const auto depth = [&](const Vec3& p) { return (poses.R_camera_board[2] * p + poses.t_camera_board[2]).z(); };
+  std::size_t on_box = 0;
+  for (const auto& p : first.cloud_board.points) {
+    EXPECT_GE(depth(p), first.depth_near_m - 1e-9);
+    EXPECT_LE(depth(p), first.depth_far_m + 1e-9);
+    on_box += s.antenna.distance(p) < 0.05;
+  }
+  EXPECT_GT(on_box, first.cloud_board.size() * 9 / 10);
+
+  RegionOptions o;
+  o.beyond_m = first.depth_far_m;
+  const auto next = reconstruct_region(s.views, poses, 2, roi, s.K, o);
+  EXPECT_GE(next.cloud_board.size(), o.min_points);
+  EXPECT_GT(next.depth_near_m, first.depth_far_m - 0.15 - 0.03 * first.depth_far_m);  // windows' widening
+  for (const auto& p : next.cloud_board.points) EXPECT_GT(s.antenna.distance(p), 0.3);
+}
+
 TEST(ReconstructRegion, SkyFailsWithMessage) {
   const Scene& s = textured_scene();
   const Roi sky{150, 10, 200, 90};

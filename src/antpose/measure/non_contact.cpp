@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <map>
 #include <random>
@@ -139,8 +140,8 @@ double roi_fill(const AntennaMeasurement& m, const Vec3& size_m, const PosedView
                 const camera::CameraIntrinsics& K) {
   Eigen::AlignedBox2d box;
   for (const Vec3& corner_antenna : model::box_corners(size_m)) {
-    const auto uv = K.project(view.R_camera_board * (m.R_board_antenna * corner_antenna + m.p_board_antenna) +
-                              view.t_camera_board);
+    const auto uv =
+        K.project(view.R_camera_board * (m.R_board_antenna * corner_antenna + m.p_board_antenna) + view.t_camera_board);
     if (!uv) return 0.0;
     box.extend(*uv);
   }
@@ -1216,6 +1217,46 @@ nlohmann::json deg_or_null(const std::optional<double>& rad) {
   return rad ? nlohmann::json(rad2deg(*rad)) : nlohmann::json(nullptr);
 }
 
+// The antenna registered to the object behind the one `near` measured, where that fills the
+// rectangle (min_roi_fill) and clearly more of it than `near` did, and its points are centred
+// within the antenna's size of `near`: one panel of several on a mount, the nearer one crossing
+// its rectangle (site 5111: 24 % for the middle one of three, 52 % for the top one marked).
+// Farther objects (a wall, a tower behind) are left alone: `near` stands, with its warning.
+// nullopt where nothing behind registers or it does not qualify.
+std::optional<std::pair<AntennaMeasurement, PointsRegistration>> measure_behind(
+    const AntennaMeasurement& near, double near_fill, const model::AntennaModel& model,
+    const std::function<reconstruction::RegionReconstruction(double beyond_m)>& reconstruct, const Scene& scene,
+    const PosedView& view, const camera::CameraIntrinsics& K, const NonContactOptions& options) {
+  AntennaMeasurement m;
+  m.roi = near.roi;
+  try {
+    m.region = reconstruct(near.region.depth_far_m);
+    // Before the registration, the costly part: points centred farther off are another object.
+    Vec3 centroid_board = Vec3::Zero();
+    for (const Vec3& p : m.region.cloud_board.points) centroid_board += p;
+    centroid_board /= static_cast<double>(m.region.cloud_board.size());
+    if ((centroid_board - near.p_board_antenna).norm() > model.size_m.norm()) return std::nullopt;
+    m.warnings = m.region.warnings;
+    auto points = register_points(m.region.cloud_board, model, scene, options);
+    register_model(m, model, points, scene, options);
+    const double fill = roi_fill(m, model.size_m, view, K);
+    const double apart_m = (m.p_board_antenna - near.p_board_antenna).norm();
+    // Half as much again: where both fill the rectangle about as well, it does not tell them apart.
+    constexpr double kClearlyMore = 1.5;
+    if (fill < options.min_roi_fill || fill < kClearlyMore * near_fill) return std::nullopt;
+    m.warnings.insert(
+        m.warnings.begin(),
+        fmt::format("the object nearest the camera in the rectangle of {} ({:.1f}–{:.1f} m away) "
+                    "registered as an antenna covering only {:.0f} % of the rectangle; the one behind it, {:.1f} m "
+                    "from it, covering {:.0f} %, was measured; check the model drawn over the photos",
+                    view.name, near.region.depth_near_m, near.region.depth_far_m, 100 * near_fill, apart_m,
+                    100 * fill));
+    return std::pair{std::move(m), std::move(points)};
+  } catch (const MeasurementError&) {
+    return std::nullopt;
+  }
+}
+
 }  // namespace
 
 AntennaRoi parse_roi(const std::string& text) {
@@ -1368,20 +1409,33 @@ NonContactResult measure_non_contact(const Capture& capture, const NonContactSet
                         "the board",
                         m.roi.image, board_poses[roi_shots[k]].reason));
       const auto view = static_cast<std::size_t>(at - result.posed.begin());
-      m.region = reconstruction::reconstruct_region(
-          views, result.poses, view, m.roi.roi, setup.intrinsics, region_options,
-          [&](const std::string& s, int d, int t) { report(options, name + ": " + s, d, t); });
+      const auto reconstruct = [&](double beyond_m) {
+        auto o = region_options;
+        o.beyond_m = beyond_m;
+        return reconstruction::reconstruct_region(
+            views, result.poses, view, m.roi.roi, setup.intrinsics, o,
+            [&](const std::string& s, int d, int t) { report(options, name + ": " + s, d, t); });
+      };
+      m.region = reconstruct(0.0);
       for (const auto& w : m.region.warnings) m.warnings.push_back(w);
       report(options, name + ": registration", 0, 1);
       if (const auto* model = setup.model_for(k)) {
         points = register_points(m.region.cloud_board, *model, scene, options);
         register_model(m, *model, *points, scene, options);
-        if (const double fill = roi_fill(m, model->size_m, views[view], setup.intrinsics); fill < options.min_roi_fill)
-          m.warnings.push_back(fmt::format(
-              "the registered antenna covers only {:.0f} % of the rectangle in {}: another object (a nearer antenna?) "
-              "may have been measured, or the rectangle is not drawn tightly around the antenna; check the model "
-              "drawn over the photos",
-              100 * fill, views[view].name));
+        const double fill = roi_fill(m, model->size_m, views[view], setup.intrinsics);
+        if (fill < options.min_roi_fill) {
+          auto behind = measure_behind(m, fill, *model, reconstruct, scene, views[view], setup.intrinsics, options);
+          if (behind) {
+            m = std::move(behind->first);
+            points = std::move(behind->second);
+          } else {
+            m.warnings.push_back(fmt::format(
+                "the registered antenna covers only {:.0f} % of the rectangle in {}: another object (a nearer "
+                "antenna?) may have been measured, or the rectangle is not drawn tightly around the antenna; check "
+                "the model drawn over the photos",
+                100 * fill, views[view].name));
+          }
+        }
       } else {
         const FaceFit fit = fit_front_face(m.region.cloud_board, scene.viewpoints, scene.up_board, options.model_free);
         m.method = "model-free (front face + long axis)";

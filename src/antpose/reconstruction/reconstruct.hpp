@@ -86,6 +86,9 @@ struct RegionOptions {
   double sor_std_ratio = 2.0;    // and the threshold in standard deviations
   double max_depth_m = 60.0;     // ignore points farther from every camera
   std::size_t min_points = 200;  // fewer: MeasurementError (e.g. an ROI on no antenna)
+  /// The object is sought among points farther than this from the region's camera (along its
+  /// axis): 0 takes the nearest; a previous result's depth_far_m takes the object behind it.
+  double beyond_m = 0.0;
   /// Points inside this board-frame box (min, max corner) are not the object: the calibration
   /// board itself when the rectangle overlaps it (nearer, and far better textured, it would
   /// otherwise be taken for the object).
@@ -97,6 +100,8 @@ struct RegionReconstruction {
   std::vector<std::optional<Roi>> rois;  // the region in each view (nullopt: out of view)
   std::size_t views_used = 0;            // views that contributed points
   std::string method;                    // "dense", "dense+features" or "features", for the report
+  /// The object's depth range along the region camera's axis (m): its sparse points' cluster.
+  double depth_near_m = 0.0, depth_far_m = 0.0;
   /// Fraction of the object's outline in views[roi_view] (cells of ≥ 8 px and ≥ 1.5 voxels inside the convex hull
   /// of the points' projections) that holds points: ~0.9 on a textured or weathered radome, low
   /// on a plain one (only edges and details carry texture; < 0.6 adds a warning).

@@ -519,6 +519,8 @@ RegionReconstruction reconstruct_beyond(const std::vector<PosedView>& views, con
         ref.name, range ? range->support : 0, kMinSparse));
   DenseContext ctx{&views, &poses, &intrinsics, roi_view, roi, *range, {}, options.max_depth_m, &options};
   ctx.volume = frustum_samples(roi, Rr, tr, intrinsics, {range->near, 0.5 * (range->near + range->far), range->far});
+  out.depth_near_m = range->near;
+  out.depth_far_m = range->far;
   out.rois.assign(n, std::nullopt);
   out.rois[roi_view] = roi;
   std::vector<int> seen_by;
@@ -716,7 +718,7 @@ RegionReconstruction reconstruct_region(const std::vector<PosedView>& views, con
                                         const camera::CameraIntrinsics& intrinsics, const RegionOptions& options,
                                         const Progress& progress) {
   try {
-    return reconstruct_beyond(views, poses, roi_view, roi, intrinsics, options, progress, 0.0);
+    return reconstruct_beyond(views, poses, roi_view, roi, intrinsics, options, progress, options.beyond_m);
   } catch (const TooFewPoints& nearest) {
     try {
       auto out = reconstruct_beyond(views, poses, roi_view, roi, intrinsics, options, progress, nearest.range.far);
