@@ -1217,6 +1217,15 @@ nlohmann::json deg_or_null(const std::optional<double>& rad) {
   return rad ? nlohmann::json(rad2deg(*rad)) : nlohmann::json(nullptr);
 }
 
+// The warning for an antenna that fills little of its rectangle (NonContactOptions::min_roi_fill).
+std::string little_fill_warning(double fill, const std::string& photo) {
+  return fmt::format(
+      "the registered antenna covers only {:.0f} % of the rectangle in {}: another object (a nearer antenna?) may "
+      "have been measured, or the rectangle is not drawn tightly around the antenna; check the model drawn over the "
+      "photos",
+      100 * fill, photo);
+}
+
 // The antenna registered to the object behind the one `near` measured, where that fills the
 // rectangle (min_roi_fill) and clearly more of it than `near` did, and its points are centred
 // within the antenna's size of `near`: one panel of several on a mount, the nearer one crossing
@@ -1395,9 +1404,14 @@ NonContactResult measure_non_contact(const Capture& capture, const NonContactSet
   };
   // Antennas whose outline fitted from no start, with their points' registration: tried again
   // with the others known.
-  std::vector<std::pair<std::size_t, PointsRegistration>> retry;
+  struct Retry {
+    std::size_t k, view;
+    PointsRegistration points;
+  };
+  std::vector<Retry> retry;
   for (std::size_t k = 0; k < setup.rois.size(); ++k) {
     AntennaMeasurement m;
+    std::size_t view = 0;  // the rectangle's photo among the posed ones
     std::optional<PointsRegistration> points;
     m.roi = setup.rois[k];
     const auto name = fmt::format("antenna {} ({})", k + 1, m.roi.image);
@@ -1408,7 +1422,7 @@ NonContactResult measure_non_contact(const Capture& capture, const NonContactSet
             fmt::format("the board was not found in {} ({}): mark the antenna in a photo that shows "
                         "the board",
                         m.roi.image, board_poses[roi_shots[k]].reason));
-      const auto view = static_cast<std::size_t>(at - result.posed.begin());
+      view = static_cast<std::size_t>(at - result.posed.begin());
       const auto reconstruct = [&](double beyond_m) {
         auto o = region_options;
         o.beyond_m = beyond_m;
@@ -1429,11 +1443,7 @@ NonContactResult measure_non_contact(const Capture& capture, const NonContactSet
             m = std::move(behind->first);
             points = std::move(behind->second);
           } else {
-            m.warnings.push_back(fmt::format(
-                "the registered antenna covers only {:.0f} % of the rectangle in {}: another object (a nearer "
-                "antenna?) may have been measured, or the rectangle is not drawn tightly around the antenna; check "
-                "the model drawn over the photos",
-                100 * fill, views[view].name));
+            m.warnings.push_back(little_fill_warning(fill, views[view].name));
           }
         }
       } else {
@@ -1450,14 +1460,14 @@ NonContactResult measure_non_contact(const Capture& capture, const NonContactSet
       finish(m);
     } catch (const OutlineNotFound& e) {
       m.error = e.what();
-      retry.emplace_back(k, std::move(*points));
+      retry.push_back({k, view, std::move(*points)});
     } catch (const MeasurementError& e) {
       m.error = e.what();
     }
     result.antennas.push_back(std::move(m));
   }
   // Antennas whose outline fitted from no start, again with the others registered known.
-  for (const auto& [k, points] : retry) {
+  for (const auto& [k, view, points] : retry) {
     auto& m = result.antennas[k];
     const bool others = std::any_of(result.antennas.begin(), result.antennas.end(),
                                     [&](const AntennaMeasurement& a) { return &a != &m && !a.error; });
@@ -1467,10 +1477,13 @@ NonContactResult measure_non_contact(const Capture& capture, const NonContactSet
     again.region = m.region;
     again.warnings = m.region.warnings;
     try {
-      register_model(again, *setup.model_for(k), points, with_other_antennas(scene, result.antennas, setup, k), options,
+      const auto& model = *setup.model_for(k);
+      register_model(again, model, points, with_other_antennas(scene, result.antennas, setup, k), options,
                      OutlinePass::kHeldAxisOnly);
       again.warnings.push_back(
           "the outline fitted only with the other antennas' registered outlines known (their edges masked)");
+      if (const double fill = roi_fill(again, model.size_m, views[view], setup.intrinsics); fill < options.min_roi_fill)
+        again.warnings.push_back(little_fill_warning(fill, views[view].name));
       finish(again);
       m = std::move(again);
     } catch (const MeasurementError& e) {
