@@ -83,7 +83,7 @@ TEST_F(MeasureCli, RoiOnTheSkyFailsThatAntennaWithItsReason) {
 
 TEST_F(MeasureCli, ARectangleTheAntennaFillsLittleOfIsNamed) {
   // The antenna's own rectangle, then one 1.8 times as wide and tall about it: the registered
-  // antenna covers about a third of that, and another object may have been taken for it.
+  // antenna covers a fifth of that (20 %), and another object may have been taken for it.
   int x = 0, y = 0, w = 0, h = 0;
   ASSERT_EQ(std::sscanf(roi_.substr(roi_image_.size() + 1).c_str(), "%d,%d,%d,%d", &x, &y, &w, &h), 4);
   const auto tight = *dir_ / "tight.json";

@@ -411,12 +411,12 @@ class TooFewPoints : public MeasurementError {
   DepthRange range;
 };
 
-// reconstruct_region, with the object sought among the sparse points more than `beyond_m` from
-// the region's camera (along its axis).
-RegionReconstruction reconstruct_beyond(const std::vector<PosedView>& views, const RefinedPoses& poses,
+// reconstruct_region without the fallback to the next object: the object is the nearest one more
+// than options.beyond_m from the region's camera (along its axis).
+RegionReconstruction reconstruct_object(const std::vector<PosedView>& views, const RefinedPoses& poses,
                                         std::size_t roi_view, const Roi& roi_in,
                                         const camera::CameraIntrinsics& intrinsics, const RegionOptions& options,
-                                        const Progress& progress, double beyond_m) {
+                                        const Progress& progress) {
   const int n = int(views.size());
   if (poses.R_camera_board.size() != views.size() || poses.t_camera_board.size() != views.size())
     throw MeasurementError(fmt::format("{} refined poses for {} photos", poses.R_camera_board.size(), views.size()));
@@ -510,7 +510,7 @@ RegionReconstruction reconstruct_beyond(const std::vector<PosedView>& views, con
   constexpr std::size_t kMinSparse = 3;
   std::vector<Vec3> candidates;
   for (const Vec3& p : sparse)
-    if ((Rr * p + tr).z() > beyond_m) candidates.push_back(p);
+    if ((Rr * p + tr).z() > options.beyond_m) candidates.push_back(p);
   const auto range = detail::nearest_depth_cluster(candidates, Rr, tr, kMinSparse);
   if (!range || range->support < kMinSparse)
     throw MeasurementError(fmt::format(
@@ -718,10 +718,12 @@ RegionReconstruction reconstruct_region(const std::vector<PosedView>& views, con
                                         const camera::CameraIntrinsics& intrinsics, const RegionOptions& options,
                                         const Progress& progress) {
   try {
-    return reconstruct_beyond(views, poses, roi_view, roi, intrinsics, options, progress, options.beyond_m);
+    return reconstruct_object(views, poses, roi_view, roi, intrinsics, options, progress);
   } catch (const TooFewPoints& nearest) {
     try {
-      auto out = reconstruct_beyond(views, poses, roi_view, roi, intrinsics, options, progress, nearest.range.far);
+      RegionOptions beyond = options;
+      beyond.beyond_m = nearest.range.far;
+      auto out = reconstruct_object(views, poses, roi_view, roi, intrinsics, beyond, progress);
       out.warnings.insert(out.warnings.begin(),
                           fmt::format("the nearest object in the region of {}, {:.1f}–{:.1f} m from the camera, gave "
                                       "too few points for an antenna (the roof's edge, a parapet?): the object beyond "
