@@ -14,6 +14,13 @@ PointCloud transformed(const PointCloud& cloud, const Iso3& T) {
   return out;
 }
 
+Vec3 centroid(const std::vector<Vec3>& points) {
+  if (points.empty()) return Vec3::Zero();
+  Vec3 sum = Vec3::Zero();
+  for (const auto& p : points) sum += p;
+  return sum / static_cast<double>(points.size());
+}
+
 std::pair<Vec3, Vec3> bounding_box(const PointCloud& cloud) {
   if (cloud.empty()) return {Vec3::Zero(), Vec3::Zero()};
   Vec3 lo = cloud.points.front(), hi = lo;

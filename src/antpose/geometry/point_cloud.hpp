@@ -29,6 +29,9 @@ struct PointCloud {
 /// The cloud with every point (and normal) mapped by T: p' = T p, n' = R n.
 PointCloud transformed(const PointCloud& cloud, const Iso3& T);
 
+/// The mean of the points; zero for none.
+Vec3 centroid(const std::vector<Vec3>& points);
+
 /// Axis-aligned bounding box of the points (min, max); both zero for an empty cloud.
 std::pair<Vec3, Vec3> bounding_box(const PointCloud& cloud);
 

@@ -773,8 +773,7 @@ Scene with_other_antennas(const Scene& scene, const std::vector<AntennaMeasureme
   Scene out = scene;
   const auto& cloud = antennas[k].region.cloud_board;
   if (cloud.empty()) return out;
-  Vec3 centre = Vec3::Zero();
-  for (const Vec3& p : cloud.points) centre += p / static_cast<double>(cloud.size());
+  const Vec3 centre = centroid(cloud.points);
   for (std::size_t j = 0; j < antennas.size(); ++j) {
     const auto* model = setup.model_for(j);
     if (j == k || antennas[j].error || !model) continue;
@@ -1241,10 +1240,7 @@ std::optional<std::pair<AntennaMeasurement, PointsRegistration>> measure_behind(
   try {
     m.region = reconstruct(near.region.depth_far_m);
     // Before the registration, the costly part: points centred farther off are another object.
-    Vec3 centroid_board = Vec3::Zero();
-    for (const Vec3& p : m.region.cloud_board.points) centroid_board += p;
-    centroid_board /= static_cast<double>(m.region.cloud_board.size());
-    if ((centroid_board - near.p_board_antenna).norm() > model.size_m.norm()) return std::nullopt;
+    if ((centroid(m.region.cloud_board.points) - near.p_board_antenna).norm() > model.size_m.norm()) return std::nullopt;
     m.warnings = m.region.warnings;
     auto points = register_points(m.region.cloud_board, model, scene, options);
     register_model(m, model, points, scene, options);

@@ -22,12 +22,6 @@ Mat3 rotation_to_up(const Vec3& up) {
   return exp_so3(axis / s * std::atan2(s, c));
 }
 
-Vec3 centroid(const std::vector<Vec3>& points) {
-  Vec3 c = Vec3::Zero();
-  for (const auto& p : points) c += p;
-  return c / static_cast<double>(points.size());
-}
-
 /// Where the model's centre starts (see the header): the centroid, and the centroids of the two
 /// halves split at it across the direction of the points' largest horizontal spread.
 std::vector<Vec3> start_centres(const std::vector<Vec3>& points, const Vec3& up, bool split) {
