@@ -1236,7 +1236,7 @@ std::string little_fill_warning(double fill, const std::string& photo) {
 std::optional<std::pair<AntennaMeasurement, PointsRegistration>> measure_behind(
     const AntennaMeasurement& near, double near_fill, const model::AntennaModel& model,
     const std::function<reconstruction::RegionReconstruction(double beyond_m)>& reconstruct, const Scene& scene,
-    const PosedView& view, const camera::CameraIntrinsics& K, const NonContactOptions& options) {
+    const PosedView& view, const NonContactOptions& options) {
   AntennaMeasurement m;
   m.roi = near.roi;
   try {
@@ -1246,7 +1246,7 @@ std::optional<std::pair<AntennaMeasurement, PointsRegistration>> measure_behind(
     m.warnings = m.region.warnings;
     auto points = register_points(m.region.cloud_board, model, scene, options);
     register_model(m, model, points, scene, options);
-    const double fill = roi_fill(m, model.size_m, view, K);
+    const double fill = roi_fill(m, model.size_m, view, scene.intrinsics);
     const double apart_m = (m.p_board_antenna - near.p_board_antenna).norm();
     // Half as much again: where both fill the rectangle about as well, it does not tell them apart.
     constexpr double kClearlyMore = 1.5;
@@ -1436,7 +1436,7 @@ NonContactResult measure_non_contact(const Capture& capture, const NonContactSet
         register_model(m, *model, *points, scene, options);
         const double fill = roi_fill(m, model->size_m, views[view], setup.intrinsics);
         if (fill < options.min_roi_fill) {
-          auto behind = measure_behind(m, fill, *model, reconstruct, scene, views[view], setup.intrinsics, options);
+          auto behind = measure_behind(m, fill, *model, reconstruct, scene, views[view], options);
           if (behind) {
             m = std::move(behind->first);
             points = std::move(behind->second);
