@@ -561,13 +561,12 @@ void decide_front_by_mount(AntennaMeasurement& m, SilhouettePick& pick, const mo
     });
   };
   if (!decided && !call.in_doubt && pick.turned && tilt_turned > tilt && turned_is_rival()) {
+    turn_round();
     m.warnings.push_back(
-        // The counts as reported, that is turned round: what lay behind the registered pose lies before it.
         fmt::format("front and back are undecided (the mount: {} points behind the panel as reported, {} before "
                     "it): of the two ways round the one with a downtilt of {:+.1f}° is reported, not the one with "
                     "{:+.1f}°",
-                    side.before, side.behind, rad2deg(tilt_turned), rad2deg(tilt)));
-    turn_round();
+                    side.behind, side.before, rad2deg(tilt_turned), rad2deg(tilt)));
     pick.rivals.push_back(pick.turned->T_board_antenna.linear());
   }
   m.mount_points = side;
