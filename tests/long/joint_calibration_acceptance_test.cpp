@@ -6,7 +6,7 @@
 // Truth: truth/device.yaml. Seeds: ANTPOSE_JOINT_SEEDS from 101 (not the seeds the methods were
 // developed on). The everyday run takes one, to keep CI's time: MeasureAcceptance calibrates a
 // second phone (seed 401, 12 MP) through the same commands and checks its rotation too; the
-// acceptance figures (RMS and NEES over seeds) take ten or more.
+// end-to-end figures in docs/camera-imu.md take 3 (ANTPOSE_JOINT_SEEDS=3).
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
