@@ -21,12 +21,13 @@
 #include "acceptance_support.hpp"
 #include "antpose/geometry/rotation.hpp"
 #include "antpose/io/text_file.hpp"
+#include "antpose/io/yaml_util.hpp"
 #include "support/test_support.hpp"
 
 namespace antpose {
 namespace {
 
-using test::matrix_rows;
+using test::json_mat3;
 using test::run;
 
 TEST(JointCalibrationAcceptance, SimulatedCapturesThroughTheCommandLine) {
@@ -60,24 +61,26 @@ TEST(JointCalibrationAcceptance, SimulatedCapturesThroughTheCommandLine) {
     ASSERT_EQ(r.status, 0) << r.err << r.out;
     if (k == 0) std::printf("%s", r.out.c_str());  // the thesis-style tables of the first seed
 
-    const YAML::Node truth = YAML::LoadFile((dir / fmt::format("joint-{}", seed) / "truth/device.yaml").string());
+    const auto truth_file = dir / fmt::format("joint-{}", seed) / "truth/device.yaml";
+    const YAML::Node truth = YAML::LoadFile(truth_file.string());
     // The device's IMU calibration was applied: its frame is the calibrated one (simulator.md).
-    const Mat3 X = matrix_rows(truth["camera_imu"]["R_calibrated_camera"]);
+    const Mat3 X = io::yaml_mat3(truth["camera_imu"]["R_calibrated_camera"], truth_file, "R_calibrated_camera");
     const double dt_true = truth["camera_imu"]["time_offset_s"].as<double>();
     const auto j = nlohmann::json::parse(io::read_text(json));
     const auto& rf = j["reference_free"];
-    const Mat3 X_free = matrix_rows(rf["R_device_camera"]);
+    const Mat3 X_free = json_mat3(rf["R_device_camera"]);
     const Vec3 e = log_so3(X_free * X.transpose());
     const Vec3 sigma =
         deg2rad(1.0) * Vec3(rf["rotation_sigma_deg"][0].get<double>(), rf["rotation_sigma_deg"][1].get<double>(),
                             rf["rotation_sigma_deg"][2].get<double>());
     const double err_free = rad2deg(e.norm());
-    const double err_thesis = rad2deg(rotation_distance(matrix_rows(j["thesis"][0]["R_device_camera"]), X));
-    const double err_smoother = rad2deg(rotation_distance(matrix_rows(j["thesis"][1]["R_device_camera"]), X));
+    const double err_thesis = rad2deg(rotation_distance(json_mat3(j["thesis"][0]["R_device_camera"]), X));
+    const double err_smoother = rad2deg(rotation_distance(json_mat3(j["thesis"][1]["R_device_camera"]), X));
     const double dt_err = rf["time_offset_s"].get<double>() - dt_true;
     // For the record: against the phone body's frame, which includes the accelerometer's own
     // mounting rotation that no IMU-based calibration can see (docs/camera-imu.md).
-    const double body = rad2deg(rotation_distance(X_free, matrix_rows(truth["camera_imu"]["R_device_camera"])));
+    const double body = rad2deg(rotation_distance(
+        X_free, io::yaml_mat3(truth["camera_imu"]["R_device_camera"], truth_file, "R_device_camera")));
     std::printf("seed %d: reference-free %.3f° from R_device_camera of the body frame\n", seed, body);
     std::printf("%-5d %8.3f (%.3f %.3f %.3f)  %-26.3f %-26.3f %7.2f (%.2f)\n", seed, err_free, rad2deg(sigma.x()),
                 rad2deg(sigma.y()), rad2deg(sigma.z()), err_thesis, err_smoother, 1e3 * dt_err,

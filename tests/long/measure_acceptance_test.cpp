@@ -27,12 +27,13 @@
 #include "antpose/geometry/attitude.hpp"
 #include "antpose/geometry/rotation.hpp"
 #include "antpose/io/text_file.hpp"
+#include "antpose/io/yaml_util.hpp"
 #include "support/test_support.hpp"
 
 namespace antpose {
 namespace {
 
-using test::matrix_rows;
+using test::json_mat3;
 using test::run;
 
 // Seconds since the last call: where the run's time goes, printed so that the everyday set of
@@ -92,10 +93,11 @@ TEST(MeasureAcceptance, SimulatedSitesThroughTheCommandLine) {
                   dev, joint_json.string()));
   // Its camera–IMU rotation against the simulator's, to JointCalibrationAcceptance's limit: a
   // second phone, at 12 MP, for that test's single everyday seed.
-  const Mat3 R_calibrated_camera = matrix_rows(
-      YAML::LoadFile((dir / "joint/truth/device.yaml").string())["camera_imu"]["R_calibrated_camera"]);
+  const auto truth_file = dir / "joint/truth/device.yaml";
+  const Mat3 R_calibrated_camera = io::yaml_mat3(
+      YAML::LoadFile(truth_file.string())["camera_imu"]["R_calibrated_camera"], truth_file, "R_calibrated_camera");
   const double joint_err_deg = rad2deg(rotation_distance(
-      matrix_rows(nlohmann::json::parse(io::read_text(joint_json))["reference_free"]["R_device_camera"]),
+      json_mat3(nlohmann::json::parse(io::read_text(joint_json))["reference_free"]["R_device_camera"]),
       R_calibrated_camera));
   std::printf("phone %d: R_device_camera %.3f° from the truth\n", device_seed, joint_err_deg);
   EXPECT_LT(joint_err_deg, 0.2);
