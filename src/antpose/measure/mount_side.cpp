@@ -5,18 +5,44 @@
 
 namespace antpose::measure {
 
+std::optional<double> seen_face_depth_noise(const std::vector<Vec3>& points, const Vec3& size_m,
+                                            const Vec3& toward_cameras, const MountSideOptions& o) {
+  // Projected areas of the broad face and of a side face, as the cameras see them.
+  if (std::abs(toward_cameras.y()) * size_m.x() < std::abs(toward_cameras.x()) * size_m.y()) return std::nullopt;
+  const double side = toward_cameras.y() >= 0.0 ? 1.0 : -1.0;
+  std::vector<double> into;  // depth behind the seen face, into the panel
+  for (const Vec3& p : points) {
+    if (std::abs(p.x()) > size_m.x() / 4 || std::abs(p.z()) > size_m.z() / 2) continue;
+    const double depth = size_m.y() / 2 - side * p.y();
+    if (depth > 0.0 && depth < size_m.y()) into.push_back(depth);
+  }
+  if (into.size() < o.min_noise_points) return std::nullopt;
+  const auto median = into.begin() + static_cast<std::ptrdiff_t>(into.size() / 2);
+  std::nth_element(into.begin(), median, into.end());
+  return *median / 0.6745;
+}
+
 MountSide count_mount_side(const PointCloud& cloud, const Iso3& T_antenna_cloud, const registration::KdTree& model,
-                           const Vec3& size_m, double reach_m, const MountSideOptions& o) {
+                           const Vec3& size_m, double reach_m, const Vec3& toward_cameras_c,
+                           const MountSideOptions& o) {
+  std::vector<Vec3> points;
+  points.reserve(cloud.size());
+  for (const auto& point : cloud.points) points.push_back(T_antenna_cloud * point);
+  const Vec3 toward_cameras = T_antenna_cloud.linear() * toward_cameras_c;
   MountSide side;
-  for (const auto& point : cloud.points) {
-    const Vec3 p = T_antenna_cloud * point;
+  side.depth_noise_m = seen_face_depth_noise(points, size_m, toward_cameras, o).value_or(0.0);
+  const bool cameras_before = toward_cameras.y() >= 0.0;
+  const double gap_cameras_side = std::max(o.gap_m, o.noise_sigmas * side.depth_noise_m);
+  for (const Vec3& p : points) {
     if (std::abs(p.x()) > size_m.x() / 2 + o.lateral_margin_m || std::abs(p.z()) > size_m.z() / 2) continue;
+    const bool before = p.y() > 0.0;
+    const double gap = before == cameras_before ? gap_cameras_side : o.gap_m;
     const double beyond = std::abs(p.y()) - size_m.y() / 2;
-    if (beyond < o.gap_m || beyond > o.depth_m) continue;
+    if (beyond < gap || beyond > o.depth_m) continue;
     std::size_t index = 0;
     double d2 = 0.0;
     if (model.nearest(p, index, d2) && d2 <= reach_m * reach_m) continue;
-    ++(p.y() < 0 ? side.behind : side.before);
+    ++(before ? side.before : side.behind);
   }
   return side;
 }

@@ -8,6 +8,14 @@
 // `reach_m` from it), inside the panel's outline across (plus `lateral_margin_m`) and along it,
 // between `gap_m` and `depth_m` beyond its back face or its front face.
 //
+// The face the cameras see most has depth noise of its own, which scatters its points towards the
+// cameras as much as into the panel: from the ground (20–30 m) σ 2–3 cm along the boresight. Seen
+// from the front that scatter lies before the panel; seen from the back, or registered turned round,
+// it lies where the mount should be, and at `gap_m` it was 116 "mount" points behind a thesis panel
+// registered turned round (5606-1, 21 m, face-on; mast and clamps hidden behind it). So on the
+// cameras' side the points are counted only beyond `noise_sigmas` times that noise too, measured
+// from the points' spread into the panel behind the seen face (where no mount lies).
+//
 // Verdict: at least `min_points` behind and `ratio` times as many as before: as registered; the
 // other way round, with at least `min_points_to_turn` before: turned (the front is the back).
 // Else undecided. On the acceptance sites 701–712 the right poses had 3.6–∞ times more behind
@@ -16,6 +24,8 @@
 #pragma once
 
 #include <cstddef>
+#include <optional>
+#include <vector>
 
 #include "antpose/geometry/point_cloud.hpp"
 #include "antpose/registration/kdtree.hpp"
@@ -32,20 +42,36 @@ struct MountSideOptions {
   /// wrong ones (1004-1, 1211-1, both turning a right pose into an uptilt) 114 and 80.
   std::size_t min_points_to_turn = 300;
   double ratio = 2.0;
+  /// On the cameras' side, points count beyond this many σ of the seen face's depth noise. 5606-1
+  /// (σ 2.4 cm), 5112-3 (2.2 cm) and 5304-2 (2.6 cm), thesis panels seen face-on from 21–26 m:
+  /// beyond 3σ 0, 164 and 5 points before their fronts, where their brackets had 0, 433 and 51
+  /// behind their backs.
+  double noise_sigmas = 3.0;
+  std::size_t min_noise_points = 30;  // fewer points behind the seen face: its noise is not known
   /// mast_side_verdict's limit: a panel's boresight this near the direction away from its mast.
   double mast_max_angle_deg = 60.0;
 };
 
 struct MountSide {
   std::size_t behind = 0, before = 0;  // points beyond the back face, beyond the front face
+  double depth_noise_m = 0.0;          // the seen face's noise (σ along y_a); 0: not measured
 };
 
 /// Counts of the file comment. `cloud` in any frame c, `T_antenna_cloud` the registered pose,
 /// `model_antenna` a tree over the model's surface samples (antenna frame), `size_m` its box
-/// (width along x_a, depth along y_a, height along z_a; the boresight is +y_a).
+/// (width along x_a, depth along y_a, height along z_a; the boresight is +y_a), `toward_cameras_c`
+/// from the panel towards the cameras (their mean), frame c.
 MountSide count_mount_side(const PointCloud& cloud, const Iso3& T_antenna_cloud,
                            const registration::KdTree& model_antenna, const Vec3& size_m, double reach_m,
-                           const MountSideOptions& options);
+                           const Vec3& toward_cameras_c, const MountSideOptions& options);
+
+/// The depth noise (σ along y_a, m) of the panel's face at y_a = ±size_m.y/2 on the side of
+/// `toward_cameras_antenna`, from the points (antenna frame) in the middle half of its width
+/// that lie up to the panel's depth behind it (a half-normal's median is 0.674σ). Nothing where
+/// the cameras see a side face more than it (their points' y_a spread is the panel's depth, not
+/// noise), or fewer than options.min_noise_points lie there.
+std::optional<double> seen_face_depth_noise(const std::vector<Vec3>& points_antenna, const Vec3& size_m,
+                                            const Vec3& toward_cameras_antenna, const MountSideOptions& options);
 
 enum class MountVerdict { kUndecided, kAsRegistered, kTurned };
 

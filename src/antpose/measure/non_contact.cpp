@@ -488,13 +488,13 @@ void decide_front_by_mount(AntennaMeasurement& m, SilhouettePick& pick, const mo
                            const registration::PreparedCloud& model_prepared, const Vec3& axis_points, double reach,
                            const Scene& scene, const NonContactOptions& options) {
   const Vec3& up_board = scene.up_board;
+  const Vec3 sight = mean_line_of_sight(scene, pick.best->T_board_antenna.translation());
   const auto count = [&](const Mat3& R_board_antenna) {
     Iso3 T_board_antenna = pick.best->T_board_antenna;
     T_board_antenna.linear() = R_board_antenna;
     return count_mount_side(m.region.cloud_board, T_board_antenna.inverse(), model_prepared.tree, model.size_m, reach,
-                            options.mount);
+                            -sight, options.mount);
   };
-  const Vec3 sight = mean_line_of_sight(scene, pick.best->T_board_antenna.translation());
   const auto downtilt = [&](const Mat3& R) {
     const KeptAxis kept = keep_axis(R.col(2), axis_points, sight, deg2rad(options.axis_gate_deg));
     return boresight_downtilt(with_long_axis(R, kept.axis), up_board);
@@ -656,7 +656,10 @@ std::optional<Mat3> hold_axis_to_points(AntennaMeasurement& m, Iso3& T_antenna_b
 // θ and 2·atan(d/w) − θ, so a panel seen from one side has a second outline minimum that far
 // round: on 4906-1 (thesis panel, seen 3–13° off its front from 23 m) the truth's basin, 38°
 // from the profile's minimum, scored 0.0669 against 0.0653. Another basin whose minimum scores
-// within options.silhouette_rival_margin is kept for the points to judge (fit_outline).
+// within options.silhouette_rival_margin, or options.silhouette_rival_share of the best score if
+// more, is kept for the points to judge (fit_outline). 5611-3 (a thesis panel between two others
+// on a rooftop, the mast and their brackets crossing its rectangle) had the truth's basin at
+// 0.384 and one 22° away at 0.321: taken alone, that one came out 21.7° off with σ 2.0°.
 struct YawBasin {
   Iso3 T_board_antenna;              // at the basin's minimum, refined between the steps
   double low_rad = 0, high_rad = 0;  // its yaws within the margin, from the minimum
@@ -712,10 +715,13 @@ YawProfile profile_yaw(const model::AntennaModel& model, const Iso3& T_board_ant
   const auto best = std::min_element(scores.begin(), scores.end()) - scores.begin();
   const Steps best_steps = steps_about(best, {});
   YawProfile profile{basin(best, best_steps), std::nullopt};
+  // Another basin is as much a rival as a start converged at another yaw (silhouette_search's
+  // `rival`): where the outline fits poorly its scores' differences mean less.
+  const double other_margin = std::max(options.silhouette_rival_margin, options.silhouette_rival_share * scores[best]);
   std::optional<std::ptrdiff_t> other;
   for (std::ptrdiff_t k = 0; k <= last; ++k) {
     const bool minimum = (k == 0 || scores[k] <= scores[k - 1]) && (k == last || scores[k] <= scores[k + 1]);
-    if (!best_steps.holds(k) && minimum && scores[k] <= scores[best] + options.silhouette_rival_margin &&
+    if (!best_steps.holds(k) && minimum && scores[k] <= scores[best] + other_margin &&
         (!other || scores[k] < scores[*other]))
       other = k;
   }
@@ -1558,7 +1564,10 @@ nlohmann::json to_json(const NonContactResult& r) {
     a["fit_rmse_m"] = ok ? nlohmann::json(m.fit_rmse_m) : nullptr;
     a["fitness"] = ok ? nlohmann::json(m.fitness) : nullptr;
     a["front_back_margin"] = m.front_back_margin ? nlohmann::json(*m.front_back_margin) : nullptr;
-    if (m.mount_points) a["mount_points"] = {{"behind", m.mount_points->behind}, {"before", m.mount_points->before}};
+    if (m.mount_points)
+      a["mount_points"] = {{"behind", m.mount_points->behind},
+                           {"before", m.mount_points->before},
+                           {"depth_noise_m", m.mount_points->depth_noise_m}};
     if (m.mast)
       a["mast"] = {{"axis_point_board_m",
                     {m.mast->axis_point_board.x(), m.mast->axis_point_board.y(), m.mast->axis_point_board.z()}},
