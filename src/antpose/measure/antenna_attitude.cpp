@@ -1,5 +1,6 @@
 #include "antpose/measure/antenna_attitude.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace antpose::measure {
@@ -19,6 +20,34 @@ AntennaAttitudeResult antenna_attitude(const BoardWorldAttitude& board, const Ma
     r.azimuth_true_sigma = std::hypot(*r.sigma.azimuth, site->declination_sigma);
   }
   return r;
+}
+
+double widen_for_rivals(AntennaAttitudeResult& at, const Mat3& R_result, const std::vector<Mat3>& rivals_board,
+                        const BoardWorldAttitude& board, const std::optional<geomag::SiteField>& site) {
+  const auto widen = [](auto& sigma, double difference) {
+    if (sigma) sigma = std::hypot(*sigma, difference / 2);
+  };
+  double turn = 0.0;
+  for (const Mat3& R : rivals_board) {
+    turn = std::max(turn, angle_between(R.col(1), R_result.col(1)));
+    // The rival's boresight in the result's frame, as a turn about the result's long axis.
+    const Vec3 boresight = R_result.transpose() * R.col(1);
+    const Mat3 R_about_axis =
+        R_result * Eigen::AngleAxisd(std::atan2(-boresight.x(), boresight.y()), Vec3::UnitZ()).toRotationMatrix();
+    double d_azimuth = 0.0, d_downtilt = 0.0, d_roll = 0.0;
+    for (const Mat3& R_other : {R, R_about_axis}) {
+      const auto other = antenna_attitude(board, R_other, Mat3::Zero(), site).magnetic;
+      if (at.magnetic.azimuth && other.azimuth)
+        d_azimuth = std::max(d_azimuth, std::abs(wrap_pi(*other.azimuth - *at.magnetic.azimuth)));
+      d_downtilt = std::max(d_downtilt, std::abs(other.downtilt - at.magnetic.downtilt));
+      if (at.magnetic.roll && other.roll) d_roll = std::max(d_roll, std::abs(wrap_pi(*other.roll - *at.magnetic.roll)));
+    }
+    widen(at.sigma.azimuth, d_azimuth);
+    widen(at.azimuth_true_sigma, d_azimuth);
+    at.sigma.downtilt = std::hypot(at.sigma.downtilt, d_downtilt / 2);
+    widen(at.sigma.roll, d_roll);
+  }
+  return turn;
 }
 
 }  // namespace antpose::measure

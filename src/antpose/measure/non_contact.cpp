@@ -1193,27 +1193,11 @@ void register_model(AntennaMeasurement& m, const model::AntennaModel& model, con
   m.model_board = transformed(points.model_cloud, T_antenna_board.inverse());
 }
 
-// Each rival pose widens each angle's σ to half its difference from the result (the spread of a
-// two-way mixture), with a warning naming the largest turn.
+// Rival poses widen the σ (antenna_attitude.hpp), with a warning naming the largest turn.
 void widen_for_rivals(AntennaMeasurement& m, const BoardWorldAttitude& board,
                       const std::optional<geomag::SiteField>& site) {
   if (m.rivals_board.empty()) return;
-  auto& at = m.attitude;
-  double turn = 0.0;
-  const auto widen = [](auto& sigma, double difference) {
-    if (sigma) sigma = std::hypot(*sigma, difference / 2);
-  };
-  for (const Mat3& R : m.rivals_board) {
-    turn = std::max(turn, angle_between(R.col(1), m.R_board_antenna.col(1)));
-    const auto other = antenna_attitude(board, R, Mat3::Zero(), site).magnetic;
-    if (at.magnetic.azimuth && other.azimuth) {
-      const double d = std::abs(wrap_pi(*other.azimuth - *at.magnetic.azimuth));
-      widen(at.sigma.azimuth, d);
-      widen(at.azimuth_true_sigma, d);
-    }
-    at.sigma.downtilt = std::hypot(at.sigma.downtilt, (other.downtilt - at.magnetic.downtilt) / 2);
-    if (at.magnetic.roll && other.roll) widen(at.sigma.roll, std::abs(wrap_pi(*other.roll - *at.magnetic.roll)));
-  }
+  const double turn = widen_for_rivals(m.attitude, m.R_board_antenna, m.rivals_board, board, site);
   m.warnings.push_back(fmt::format(
       "the registration is ambiguous: the model turned {:.0f}° fits nearly as well; the σ of each angle covers it",
       rad2deg(turn)));
