@@ -43,9 +43,9 @@ struct MountSideOptions {
   std::size_t min_points_to_turn = 300;
   double ratio = 2.0;
   /// On the cameras' side, points count beyond this many σ of the seen face's depth noise. 5606-1
-  /// (σ 2.4 cm), 5112-3 (2.2 cm) and 5304-2 (2.6 cm), thesis panels seen face-on from 21–26 m:
-  /// beyond 3σ 0, 164 and 5 points before their fronts, where their brackets had 0, 433 and 51
-  /// behind their backs.
+  /// (σ 2.4 cm), 5112-3 (2.2 cm) and 5304-2 (2.6 cm), thesis panels seen face-on from 21–26 m, in
+  /// their true frames over the panel's footprint: before their fronts 224, 1800 and 252 points
+  /// beyond 3 cm, 0, 164 and 0 beyond 3σ; behind their backs, beyond 3 cm, 8, 464 and 403.
   double noise_sigmas = 3.0;
   std::size_t min_noise_points = 30;  // fewer points behind the seen face: its noise is not known
   /// mast_side_verdict's limit: a panel's boresight this near the direction away from its mast.
