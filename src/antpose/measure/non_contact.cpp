@@ -231,6 +231,13 @@ std::vector<registration::SilhouetteResult> both_edge_searches(Descend&& descend
   return out;
 }
 
+// How much worse than the best a pose at another yaw may score and still be a rival: where the
+// outline fits poorly (part hidden, clutter beside it), the score's differences between poses
+// mean less (options.silhouette_rival_share).
+double other_yaw_margin(const NonContactOptions& options, double best_score) {
+  return std::max(options.silhouette_rival_margin, options.silhouette_rival_share * best_score);
+}
+
 // The silhouette stage: starts turned about the vertical from the points' pose by each start
 // angle, refined by the outline in every photo, the best of them again from tilted along the line
 // of sight; the converged result with the lowest score (the outline's mean truncated edge cost)
@@ -392,8 +399,7 @@ SilhouettePick silhouette_search(const model::AntennaModel& model, const Iso3& T
       return r.score_with_attachments < best.score_with_attachments + options.silhouette_rival_margin
                  ? Rival::kTurnedRound
                  : Rival::kNone;
-    const double margin = std::max(options.silhouette_rival_margin, options.silhouette_rival_share * best.score);
-    return r.score < best.score + margin ? Rival::kOtherYaw : Rival::kNone;
+    return r.score < best.score + other_yaw_margin(options, best.score) ? Rival::kOtherYaw : Rival::kNone;
   };
   for (std::size_t i = 1; i < done.size(); ++i)
     if (const Rival kind = rival(done[i], done.front()); kind != Rival::kNone) {
@@ -716,8 +722,8 @@ YawProfile profile_yaw(const model::AntennaModel& model, const Iso3& T_board_ant
   const Steps best_steps = steps_about(best, {});
   YawProfile profile{basin(best, best_steps), std::nullopt};
   // Another basin is as much a rival as a start converged at another yaw (silhouette_search's
-  // `rival`): where the outline fits poorly its scores' differences mean less.
-  const double other_margin = std::max(options.silhouette_rival_margin, options.silhouette_rival_share * scores[best]);
+  // `rival`).
+  const double other_margin = other_yaw_margin(options, scores[best]);
   std::optional<std::ptrdiff_t> other;
   for (std::ptrdiff_t k = 0; k <= last; ++k) {
     const bool minimum = (k == 0 || scores[k] <= scores[k - 1]) && (k == last || scores[k] <= scores[k + 1]);
