@@ -97,8 +97,8 @@ TEST(MeasureAcceptance, SimulatedSitesThroughTheCommandLine) {
     run(fmt::format("simulate capture -o {} --scenario joint-calibration --seed {} {}", path("joint"), device_seed,
                     camera));
     const auto joint_json = dir / "joint.json";
-    run(fmt::format("calibrate joint {} {} --method reference-free --param gyro_trapezoid=1 --json '{}'",
-                    path("joint"), dev, joint_json.string()));
+    run(fmt::format("calibrate joint {} {} --method reference-free --param gyro_trapezoid=1 --json '{}'", path("joint"),
+                    dev, joint_json.string()));
     // Its camera–IMU rotation against the simulator's, to JointCalibrationAcceptance's limit, and
     // against the stored profile's (which the everyday run uses: regenerate it if they differ).
     const auto truth_file = dir / "joint/truth/device.yaml";
@@ -168,7 +168,8 @@ TEST(MeasureAcceptance, SimulatedSitesThroughTheCommandLine) {
     const YAML::Node truth = YAML::LoadFile((dir / name / "truth/scene.yaml").string());
     std::vector<std::pair<int, YAML::Node>> measured;  // (1-based antenna, its truth) of each --roi
     for (std::size_t i = 0; i < truth["antennas"].size(); ++i)
-      if (only == 0 || only == static_cast<int>(i) + 1) measured.emplace_back(static_cast<int>(i) + 1, truth["antennas"][i]);
+      if (only == 0 || only == static_cast<int>(i) + 1)
+        measured.emplace_back(static_cast<int>(i) + 1, truth["antennas"][i]);
     std::string rois;
     for (const auto& [i, a] : measured) {
       const auto roi = a["roi"];
@@ -188,16 +189,16 @@ TEST(MeasureAcceptance, SimulatedSitesThroughTheCommandLine) {
     const auto& poses = j["camera_poses"];
     std::printf("%-4d camera poses: board %.2f px, scene %.2f px over %d tracks\n", seed,
                 poses["board_rms_px"].get<double>(), poses["scene_rms_px"].get<double>(), poses["tracks"].get<int>());
-    for (std::size_t r = 0; r < measured.size(); ++r) {
-      const auto& [i, a] = measured[r];
-      const auto& m = j["antennas"][r];
+    for (std::size_t n = 0; n < measured.size(); ++n) {
+      const auto& [i, a] = measured[n];
+      const auto& m = j["antennas"][n];
       ASSERT_TRUE(m.contains("azimuth_magnetic_deg") && m.contains("uncertainty_deg")) << m.dump();
       if (!m["error"].is_null()) {
         EXPECT_FALSE(m["error"].get<std::string>().empty());
         EXPECT_TRUE(m["azimuth_magnetic_deg"].is_null());
         ++failures;
-        std::printf("%-4d %-8s %-5s %-3d FAILED: %s\n", seed, ground ? "ground" : "rooftop",
-                    disturbance ? "yes" : "no", i, m["error"].get<std::string>().c_str());
+        std::printf("%-4d %-8s %-5s %-3d FAILED: %s\n", seed, ground ? "ground" : "rooftop", disturbance ? "yes" : "no",
+                    i, m["error"].get<std::string>().c_str());
         continue;
       }
       const double az =
