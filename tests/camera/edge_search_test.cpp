@@ -89,5 +89,21 @@ TEST(EdgeSearch, ALineEndingBehindAtThePanelsMiddleFindsItsOwnWeakerEdge) {
   EXPECT_NEAR(31.0 - *own, 29.5, 0.3);
 }
 
+// The gradient along a normal is the bilinear blend of the four pixels about the point, for both
+// images with the same weights, and 0 where the four are not all inside (the search line's end).
+TEST(EdgeSearch, GradientAlongANormalBlendsTheFourPixelsAboutThePoint) {
+  cv::Mat gx(4, 5, CV_32F), gy(4, 5, CV_32F);
+  for (int y = 0; y < 4; ++y)
+    for (int x = 0; x < 5; ++x)
+      gx.at<float>(y, x) = static_cast<float>(10 * x + y), gy.at<float>(y, x) = static_cast<float>(x * y);
+  const Vec2 normal(0.6, 0.8);
+  // At (1.25, 2.5): gx is linear, 10·1.25 + 2.5 = 15; gy blends 2, 3 (row 2) and 3, 4.5 (row 3).
+  const double gy_here = 0.5 * (0.75 * 2 + 0.25 * 4) + 0.5 * (0.75 * 3 + 0.25 * 6);
+  EXPECT_NEAR(gradient_along(gx, gy, Vec2(1.25, 2.5), normal), 0.6 * 15.0 + 0.8 * gy_here, 1e-5);
+  EXPECT_NEAR(gradient_along(gx, gy, Vec2(3.0, 1.0), normal), 0.6 * 31.0 + 0.8 * 3.0, 1e-5);
+  for (const Vec2& off : {Vec2(-0.1, 1.0), Vec2(4.0, 1.0), Vec2(1.0, 3.0), Vec2(2.0, -0.5)})
+    EXPECT_EQ(gradient_along(gx, gy, off, normal), 0.0) << off.transpose();
+}
+
 }  // namespace
 }  // namespace antpose::camera

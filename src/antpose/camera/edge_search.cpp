@@ -27,13 +27,16 @@ std::pair<cv::Mat, cv::Mat> smoothed_gradients(const cv::Mat& image, double sigm
   return {gx, gy};
 }
 
-float bilinear(const cv::Mat& m, double x, double y) {
-  const int x0 = static_cast<int>(std::floor(x)), y0 = static_cast<int>(std::floor(y));
-  if (x0 < 0 || y0 < 0 || x0 + 1 >= m.cols || y0 + 1 >= m.rows) return 0.f;
-  const float fx = static_cast<float>(x - x0), fy = static_cast<float>(y - y0);
-  const float* r0 = m.ptr<float>(y0);
-  const float* r1 = m.ptr<float>(y0 + 1);
-  return (1 - fy) * ((1 - fx) * r0[x0] + fx * r0[x0 + 1]) + fy * ((1 - fx) * r1[x0] + fx * r1[x0 + 1]);
+double gradient_along(const cv::Mat& gx, const cv::Mat& gy, const Vec2& z, const Vec2& normal) {
+  const int x0 = static_cast<int>(std::floor(z.x())), y0 = static_cast<int>(std::floor(z.y()));
+  if (x0 < 0 || y0 < 0 || x0 + 1 >= gx.cols || y0 + 1 >= gx.rows) return 0.0;
+  const float fx = static_cast<float>(z.x() - x0), fy = static_cast<float>(z.y() - y0);
+  const auto sample = [&](const cv::Mat& m) {
+    const float* r0 = m.ptr<float>(y0);
+    const float* r1 = m.ptr<float>(y0 + 1);
+    return (1 - fy) * ((1 - fx) * r0[x0] + fx * r0[x0 + 1]) + fy * ((1 - fx) * r1[x0] + fx * r1[x0 + 1]);
+  };
+  return sample(gx) * normal.x() + sample(gy) * normal.y();
 }
 
 std::optional<double> nearest_edge(const cv::Mat& gx, const cv::Mat& gy, const Vec2& centre, const Vec2& normal,
@@ -46,7 +49,7 @@ std::optional<double> nearest_edge(const cv::Mat& gx, const cv::Mat& gy, const V
   double gmax = 0;
   for (int i = -behind; i <= ahead; ++i) {
     const Vec2 z = centre + (i * step_px) * normal;
-    g[i + behind] = std::abs(bilinear(gx, z.x(), z.y()) * normal.x() + bilinear(gy, z.x(), z.y()) * normal.y());
+    g[i + behind] = std::abs(gradient_along(gx, gy, z, normal));
     gmax = std::max(gmax, g[i + behind]);
   }
   if (gmax < min_gradient) return std::nullopt;

@@ -39,7 +39,8 @@ std::optional<double> nearest_edge(const cv::Mat& gx, const cv::Mat& gy, const V
                                    EdgeSearchSpan span, double min_gradient, std::vector<double>& scratch,
                                    double relative = 0.5, double step_px = 0.5);
 
-/// Bilinear sample of a CV_32F image at (x, y); 0 outside.
-float bilinear(const cv::Mat& m, double x, double y);
+/// The gradient's component along `normal` at `z` (px): the bilinear samples of the CV_32F
+/// gradient images gx and gy (0 outside), weighted once for both.
+double gradient_along(const cv::Mat& gx, const cv::Mat& gy, const Vec2& z, const Vec2& normal);
 
 }  // namespace antpose::camera

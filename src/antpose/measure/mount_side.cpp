@@ -41,7 +41,7 @@ MountSide count_mount_side(const PointCloud& cloud, const Iso3& T_antenna_cloud,
     if (beyond < gap || beyond > o.depth_m) continue;
     std::size_t index = 0;
     double d2 = 0.0;
-    if (model.nearest(p, index, d2) && d2 <= reach_m * reach_m) continue;
+    if (model.nearest(p, index, d2, reach_m * reach_m)) continue;
     ++(before ? side.before : side.behind);
   }
   return side;

@@ -827,7 +827,7 @@ PointsFit points_fit(const PointCloud& cloud, const registration::KdTree& model,
   for (const auto& p : cloud.points) {
     std::size_t index = 0;
     double d2 = 0.0;
-    if (model.nearest(T_antenna_board * p, index, d2) && d2 <= reach * reach) ss += d2, ++near;
+    if (model.nearest(T_antenna_board * p, index, d2, reach * reach)) ss += d2, ++near;
   }
   PointsFit fit;
   if (!cloud.empty()) fit.fitness = static_cast<double>(near) / static_cast<double>(cloud.size());

@@ -228,9 +228,7 @@ std::optional<PhotoEstimate> edges_across(EdgeView& ev, std::size_t index, const
     const Vec2 c = *a + (*b - *a) * ((j + 0.5) / heights) - ev.offset;
     for (int k = -half; k <= half; ++k) {
       const Vec2 z = c + (k * step) * normal;
-      profile[static_cast<std::size_t>(k + half)] +=
-          (camera::bilinear(ev.gx, z.x(), z.y()) * normal.x() + camera::bilinear(ev.gy, z.x(), z.y()) * normal.y()) /
-          heights;
+      profile[static_cast<std::size_t>(k + half)] += camera::gradient_along(ev.gx, ev.gy, z, normal) / heights;
     }
   }
   const auto pair = edge_pair(profile, step, 2 * o.min_radius_m * px_per_m, 2 * o.max_radius_m * px_per_m,

@@ -608,7 +608,7 @@ RegionReconstruction reconstruct_object(const std::vector<PosedView>& views, con
           std::size_t idx;
           double d2;
           const double tol = std::max({options.voxel_m, 3 * clouds[p].tolerance_m, 3 * clouds[q].tolerance_m});
-          if (trees[q]->nearest(pt, idx, d2) && d2 <= tol * tol) {
+          if (trees[q]->nearest(pt, idx, d2, tol * tol)) {
             dense.push_back(pt);
             contributed[clouds[p].a] = contributed[clouds[p].b] = 1;
             break;

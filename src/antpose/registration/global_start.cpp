@@ -84,8 +84,7 @@ std::pair<double, double> score(const PreparedCloud& scene, const PreparedCloud&
   for (const auto& p : scene.cloud.points) {
     std::size_t j;
     double d2;
-    model.tree.nearest(T_model_scene * p, j, d2);
-    residual += std::min(d2, tau2) / tau2;
+    residual += model.tree.nearest(T_model_scene * p, j, d2, tau2) ? d2 / tau2 : 1.0;
   }
   residual /= static_cast<double>(scene.cloud.size());
   if (o.viewpoints_scene.empty()) return {residual, 0.0};
@@ -103,7 +102,7 @@ std::pair<double, double> score(const PreparedCloud& scene, const PreparedCloud&
     ++facing;
     std::size_t j;
     double d2;
-    if (!scene.tree.nearest(m.points[i], j, d2) || d2 > tau2) ++missing;
+    if (!scene.tree.nearest(m.points[i], j, d2, tau2)) ++missing;
   }
   return {residual, facing ? static_cast<double>(missing) / static_cast<double>(facing) : 0.0};
 }

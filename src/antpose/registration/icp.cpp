@@ -77,7 +77,7 @@ Sums accumulate(const PreparedCloud& source, const PreparedCloud& target, const 
           const Vec3 p = T * src[i];
           std::size_t j;
           double d2;
-          if (!target.tree.nearest(p, j, d2) || d2 > max_d2) continue;
+          if (!target.tree.nearest(p, j, d2, max_d2)) continue;
           const Vec3& q = dst[j];
           const Eigen::Matrix<double, 3, 6> J = point_jacobian(p);
           ++s.pairs;
@@ -220,7 +220,7 @@ double fitness_score(const PointCloud& source, const KdTree& target, const Iso3&
   for (const auto& p : source.points) {
     std::size_t j;
     double d2;
-    if (target.nearest(T_target_source * p, j, d2) && d2 <= max_d2) sum += d2, ++n;
+    if (target.nearest(T_target_source * p, j, d2, max_d2)) sum += d2, ++n;
   }
   return n ? sum / static_cast<double>(n) : std::numeric_limits<double>::infinity();
 }

@@ -1,5 +1,7 @@
 #include "antpose/registration/kdtree.hpp"
 
+#include <cmath>
+
 #include <nanoflann.hpp>
 
 namespace antpose::registration {
@@ -33,12 +35,17 @@ KdTree& KdTree::operator=(KdTree&&) noexcept = default;
 
 const std::vector<Vec3>& KdTree::points() const { return impl_->points; }
 
-bool KdTree::nearest(const Vec3& query, std::size_t& index, double& squared_distance) const {
+bool KdTree::nearest(const Vec3& query, std::size_t& index, double& squared_distance,
+                     double max_squared_distance) const {
   if (impl_->points.empty()) return false;
   nanoflann::KNNResultSet<double, std::size_t> result(1);
   result.init(&index, &squared_distance);
+  // The result set's worst distance is the search's pruning bound, and nanoflann takes a point
+  // only strictly closer than it: the next double above the bound keeps points at the bound.
+  if (max_squared_distance < std::numeric_limits<double>::infinity())
+    squared_distance = std::nextafter(max_squared_distance, std::numeric_limits<double>::infinity());
   impl_->tree.findNeighbors(result, query.data(), nanoflann::SearchParams());
-  return true;
+  return result.size() > 0;
 }
 
 std::size_t KdTree::knn(const Vec3& query, std::size_t k, std::vector<std::size_t>& indices,

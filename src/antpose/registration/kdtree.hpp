@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstddef>
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -21,8 +22,11 @@ class KdTree {
   const std::vector<Vec3>& points() const;
   std::size_t size() const { return points().size(); }
 
-  /// The nearest point: false for an empty tree, else its index and squared distance (m²).
-  bool nearest(const Vec3& query, std::size_t& index, double& squared_distance) const;
+  /// The nearest point within `max_squared_distance` (m²): its index and squared distance, or
+  /// false where there is none (an empty tree). A bound prunes the search: ICP and scores ask
+  /// only about nearby points, and most of the tree lies beyond them.
+  bool nearest(const Vec3& query, std::size_t& index, double& squared_distance,
+               double max_squared_distance = std::numeric_limits<double>::infinity()) const;
   /// Up to k nearest points, closest first; returns how many were found.
   std::size_t knn(const Vec3& query, std::size_t k, std::vector<std::size_t>& indices,
                   std::vector<double>& squared_distances) const;
