@@ -30,6 +30,7 @@ struct EdgeMesh {
     std::vector<std::uint32_t> faces;
   };
   std::vector<Edge> edges;
+  bool closed = false;  // every edge between two triangles or more: the mesh bounds a solid
 };
 
 EdgeMesh weld(const model::Mesh& mesh) {
@@ -57,6 +58,7 @@ EdgeMesh weld(const model::Mesh& mesh) {
       m.edges[it->second].faces.push_back(f);
     }
   }
+  m.closed = std::all_of(m.edges.begin(), m.edges.end(), [](const EdgeMesh::Edge& e) { return e.faces.size() >= 2; });
   return m;
 }
 
@@ -181,7 +183,8 @@ void gather(const EdgeMesh& m, const Pose& pose, const PreparedView& v, const ca
   for (std::size_t f = 0; f < m.triangles.size(); ++f)
     front[f] = m.normals[f].dot(centre_antenna - m.vertices[m.triangles[f][0]]) > 0;
 
-  // Mask of the projection (front faces cover it for a closed mesh), edges subdivided so that the
+  // Mask of the projection (for a closed mesh its front faces alone cover it: every line of sight
+  // into the solid enters through one), edges subdivided so that the
   // distortion's bowing is kept; over the projection's own box (so that the outer-contour test
   // also works outside the crop, where samples are counted as unmeasurable), at most ~1000 px.
   std::vector<std::optional<Vec2>> uv(m.vertices.size());
@@ -201,6 +204,7 @@ void gather(const EdgeMesh& m, const Pose& pose, const PreparedView& v, const ca
   auto to_mask = [&](const Vec2& p) { return Vec2((p.x() - origin.x()) / ms, (p.y() - origin.y()) / ms); };
   std::vector<cv::Point> poly;
   for (std::size_t f = 0; f < m.triangles.size(); ++f) {
+    if (m.closed && !front[f]) continue;
     const auto& t = m.triangles[f];
     poly.clear();
     for (int k = 0; k < 3; ++k) {
