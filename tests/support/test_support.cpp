@@ -14,11 +14,13 @@ namespace fs = std::filesystem;
 fs::path shared_path(std::string_view relative) {
   const fs::path root = ANTPOSE_SHARED_DIR;
   if (!fs::is_directory(root))
-    throw std::runtime_error("shared reference folder not found: " + root.string() +
-                             " (set the CMake cache variable ANTPOSE_SHARED_DIR to the folder holding notes/ and data/)");
+    throw std::runtime_error(
+        "shared reference folder not found: " + root.string() +
+        " (set the CMake cache variable ANTPOSE_SHARED_DIR to the folder holding notes/ and data/)");
   const fs::path p = root / relative;
   if (!fs::exists(p))
-    throw std::runtime_error("shared reference data missing: " + p.string() + " (ANTPOSE_SHARED_DIR=" + root.string() + ")");
+    throw std::runtime_error("shared reference data missing: " + p.string() + " (ANTPOSE_SHARED_DIR=" + root.string() +
+                             ")");
   return p;
 }
 
@@ -41,6 +43,8 @@ void write_file(const fs::path& file, std::string_view content) {
   out.write(content.data(), static_cast<std::streamsize>(content.size()));
   if (!out) throw std::runtime_error("cannot write test file " + file.string());
 }
+
+std::filesystem::path cli_path() { return ANTPOSE_CLI_PATH; }
 
 CliResult run_cli(const std::string& args) {
   TempDir dir;

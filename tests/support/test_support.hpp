@@ -45,6 +45,9 @@ struct CliResult {
 /// Runs the antpose executable with the given argument string (shell syntax).
 CliResult run_cli(const std::string& args);
 
+/// The antpose executable the tests run (for scripts that take it).
+std::filesystem::path cli_path();
+
 /// The message of the InputError that `f` throws; fails the calling test when it throws none.
 template <class F>
 std::string input_error(F&& f) {

@@ -261,6 +261,21 @@ struct SearchStarts {
   std::optional<Vec3> axis;  // the starts' long axis (board frame); none: upright, the board's up
   bool hold_axis = false;    // every descent keeps `axis` (refine_holding_axis)
   bool placed = false;       // each start first moved onto the outline with its rotation held
+  /// The starts' yaws (degrees from the points' boresight; empty: options.silhouette_yaw_starts_deg),
+  /// each also turned about the mean line of sight by each of `sight_turns_deg`.
+  std::vector<double> yaws_deg;
+  std::vector<double> sight_turns_deg{0.0};
+
+  static SearchStarts held_on(const Vec3& axis) {
+    SearchStarts s;
+    s.axis = axis, s.hold_axis = true;
+    return s;
+  }
+  static SearchStarts placed_on(const std::optional<Vec3>& axis) {
+    SearchStarts s;
+    s.axis = axis, s.placed = true;
+    return s;
+  }
 };
 
 SilhouettePick silhouette_search(const model::AntennaModel& model, const Iso3& T_board_antenna, const Scene& scene,
@@ -334,25 +349,31 @@ SilhouettePick silhouette_search(const model::AntennaModel& model, const Iso3& T
     placing->silhouette_options.free = {false, false, false, true, true, true};
     placing->silhouette_options.rival_yaw_offsets_rad.clear();
   }
-  const auto start_at = [&](double yaw_deg) {
+  const auto start_at = [&](double yaw_deg, double sight_turn_deg) {
     Iso3 start = upright_at(yaw_deg);
+    if (sight_turn_deg != 0.0)
+      start.linear() =
+          Eigen::AngleAxisd(deg2rad(sight_turn_deg), mean_line_of_sight(scene, start.translation()).normalized()) *
+          start.linear();
     if (placing)
       start.translation() = refine_outline(model, start, scene, *placing, false).T_board_antenna.translation();
     return start;
   };
-  for (const double yaw : options.silhouette_yaw_starts_deg) {
-    for (auto& r : descend_both(start_at(yaw), options.silhouette_redescents)) {
-      if (r.converged && r.score > options.silhouette_max_score) {
-        r.converged = false;
-        r.warnings.push_back(fmt::format("the outline fits poorly: score {:.2f} (at most {:.2f})", r.score,
-                                         options.silhouette_max_score));
+  const auto& yaws = starts.yaws_deg.empty() ? options.silhouette_yaw_starts_deg : starts.yaws_deg;
+  for (const double yaw : yaws)
+    for (const double turn : starts.sight_turns_deg) {
+      for (auto& r : descend_both(start_at(yaw, turn), options.silhouette_redescents)) {
+        if (r.converged && r.score > options.silhouette_max_score) {
+          r.converged = false;
+          r.warnings.push_back(fmt::format("the outline fits poorly: score {:.2f} (at most {:.2f})", r.score,
+                                           options.silhouette_max_score));
+        }
+        if (r.converged)
+          done.push_back(std::move(r));
+        else if (failed_score > r.score)
+          failed_score = r.score, pick.closest_failure = r.warnings;
       }
-      if (r.converged)
-        done.push_back(std::move(r));
-      else if (failed_score > r.score)
-        failed_score = r.score, pick.closest_failure = r.warnings;
     }
-  }
   if (done.empty()) return pick;
   // The later descents (polish, tilt probe) join the starts' converged ones where they fit as well.
   const auto keep_if_fits = [&](registration::SilhouetteResult& r) {
@@ -365,7 +386,7 @@ SilhouettePick silhouette_search(const model::AntennaModel& model, const Iso3& T
   // competes only where a descent converged: alone, it settles on whatever edges lie within its
   // ±4 px, and it won confidently wrong where the held-axis search was needed (1304-2, 45° off
   // with σ 1.6°; 604-1 and 1706-2).
-  for (auto& r : descend_both(start_at(0.0), 0, true)) keep_if_fits(r);
+  for (auto& r : descend_both(start_at(0.0, 0.0), 0, true)) keep_if_fits(r);
   const auto by_score = [](const auto& a, const auto& b) { return a.score < b.score; };
   std::sort(done.begin(), done.end(), by_score);
   // Seen from below, a downtilt tilts the panel's axis along the line of sight, which hardly moves
@@ -957,7 +978,8 @@ OutlineSearch search_outline(const PointCloud& cloud_board, const model::Antenna
   if ((!pick.best || doubtful) && options.held_axis_search) {
     auto with_the_mast = with_mast(cloud_board, site, T_antenna_board, model, options);
     const Vec3 axis = points_axis();
-    auto held = silhouette_search(model, T_antenna_board.inverse(), with_the_mast.scene, options, {axis, true});
+    auto held =
+        silhouette_search(model, T_antenna_board.inverse(), with_the_mast.scene, options, SearchStarts::held_on(axis));
     held.tried += pick.tried;
     // The held search knows the mast, which hides part of the outline, so its scores are not the
     // free search's: the free winner is descended again in its scene and compared there. On
@@ -984,10 +1006,12 @@ OutlineSearch search_outline(const PointCloud& cloud_board, const model::Antenna
   // The points' winner may sit on the mast beside the panel (a rooftop pipe with more points than
   // a sparse radome: 3201-1, 0.41 m off, no outline start within reach): the free search is
   // repeated from the points' best poses started elsewhere, in turn, their outline judging them.
-  // Last, the free search from the points' pose again, its starts on the points' long axis and
+  // Then the free search from the points' pose again, its starts on the points' long axis and
   // each placed first (SearchStarts::placed): on 4502-1 the points' axis lay 0.2° from the
-  // truth's where upright was 6.9° off, and their box 7 cm to the side of the panel. Both run
-  // only where all else failed, so no answer found before them changes.
+  // truth's where upright was 6.9° off, and their box 7 cm to the side of the panel. Last, the
+  // fine placed search (options.fine_yaw_step_deg): where the points are far off in both place
+  // and axis, a panel seen side-on has a basin too narrow for the starts 25° apart. All run only
+  // where all else failed, so no answer found before them changes.
   const auto search_again = [&](const Iso3& T_board_start, const SearchStarts& starts) {
     auto again = silhouette_search(model, T_board_start, site, options, starts);
     again.tried += pick.tried;
@@ -1004,7 +1028,13 @@ OutlineSearch search_outline(const PointCloud& cloud_board, const model::Antenna
     bool found = false;
     for (const Iso3& T : other_positions(points.start, model.size_m, options.other_position_m, options.other_positions))
       if ((found = search_again(T.inverse(), {}))) break;
-    if (!found) search_again(T_antenna_board.inverse(), {points_axis(), false, true});
+    if (!found) found = search_again(T_antenna_board.inverse(), SearchStarts::placed_on(points_axis()));
+    if (!found && options.fine_yaw_step_deg > 0.0) {
+      auto fine = SearchStarts::placed_on(std::nullopt);
+      for (double yaw = -90.0; yaw < 90.0 - 1e-9; yaw += options.fine_yaw_step_deg) fine.yaws_deg.push_back(yaw);
+      fine.sight_turns_deg = options.fine_sight_turns_deg;
+      search_again(T_antenna_board.inverse(), fine);
+    }
   }
   return s;
 }
@@ -1237,7 +1267,8 @@ std::optional<std::pair<AntennaMeasurement, PointsRegistration>> measure_behind(
   try {
     m.region = reconstruct(near.region.depth_far_m);
     // Before the registration, the costly part: points centred farther off are another object.
-    if ((centroid(m.region.cloud_board.points) - near.p_board_antenna).norm() > model.size_m.norm()) return std::nullopt;
+    if ((centroid(m.region.cloud_board.points) - near.p_board_antenna).norm() > model.size_m.norm())
+      return std::nullopt;
     m.warnings = m.region.warnings;
     auto points = register_points(m.region.cloud_board, model, scene, options);
     register_model(m, model, points, scene, options);

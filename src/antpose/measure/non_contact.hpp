@@ -88,6 +88,16 @@ struct NonContactOptions {
   /// (other_positions).
   std::size_t other_positions = 2;
   double other_position_m = 0.15;
+  /// Last, where every other search failed: upright starts every this many degrees within ±90° of
+  /// the points' boresight, each also turned about the mean line of sight by each of
+  /// `fine_sight_turns_deg`, and placed before they descend; 0: none. 5810-1 (a 2 m panel 27 m
+  /// away, seen side-on from behind over a 9° arc) was refused: the points lay 0.20 m off towards
+  /// the mast and 76° off in rotation, and the outline placed and then descended to the truth
+  /// (0.021, against 0.47 for the best wrong pose) only from yaws −5° to +10° of it with its
+  /// in-image tilt right. Seen side-on, its 5.2° downtilt turns it in the photos, so upright
+  /// starts missed even at the true yaw. Answered, it is 0.02° off in azimuth, 0.06° in downtilt.
+  double fine_yaw_step_deg = 10.0;
+  std::vector<double> fine_sight_turns_deg = {-6.0, 0.0, 6.0};
   double silhouette_rival_margin = 0.02;  // a converged start within this score is a rival
   /// ... or, at another yaw, within this share of the winner's score, if more. Poses 67–79° apart
   /// scored 0.288 and 0.343 (2912-2, the worse one right) and 0.294 and 0.368 (2112-3, the better
