@@ -184,9 +184,9 @@ void gather(const EdgeMesh& m, const Pose& pose, const PreparedView& v, const ca
     front[f] = m.normals[f].dot(centre_antenna - m.vertices[m.triangles[f][0]]) > 0;
 
   // Mask of the projection (for a closed mesh its front faces alone cover it: every line of sight
-  // into the solid enters through one), edges subdivided so that the
-  // distortion's bowing is kept; over the projection's own box (so that the outer-contour test
-  // also works outside the crop, where samples are counted as unmeasurable), at most ~1000 px.
+  // into the solid enters through one), edges subdivided so that the distortion's bowing is kept;
+  // over the projection's own box (so that the outer-contour test also works outside the crop,
+  // where samples are counted as unmeasurable), at most ~1000 px.
   std::vector<std::optional<Vec2>> uv(m.vertices.size());
   Vec2 lo = Vec2::Constant(1e300), hi = Vec2::Constant(-1e300);
   for (std::size_t i = 0; i < m.vertices.size(); ++i) {
