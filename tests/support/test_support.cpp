@@ -8,6 +8,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include <fmt/format.h>
+
 namespace antpose::test {
 namespace fs = std::filesystem;
 
@@ -48,8 +50,8 @@ std::filesystem::path cli_path() { return ANTPOSE_CLI_PATH; }
 
 CliResult run_cli(const std::string& args) {
   TempDir dir;
-  const std::string cmd = std::string("'") + ANTPOSE_CLI_PATH + "' " + args + " >'" + (dir / "out").string() + "' 2>'" +
-                          (dir / "err").string() + "'";
+  const std::string cmd =
+      fmt::format("'{}' {} >'{}' 2>'{}'", cli_path().string(), args, (dir / "out").string(), (dir / "err").string());
   const int raw = std::system(cmd.c_str());
   CliResult r;
   r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
