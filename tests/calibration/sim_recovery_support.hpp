@@ -9,7 +9,7 @@
 #include "antpose/calibration/gyroscope.hpp"
 #include "antpose/sim/imu_simulator.hpp"
 
-namespace antpose::calibration::test {
+namespace antpose::test {
 
 struct SimulatedCalibration {
   Capture capture;
@@ -35,8 +35,9 @@ inline SimulatedCalibration simulate_calibration(std::uint64_t seed, double hold
   const auto& a = s.phone.accelerometer;
   const auto& g = s.phone.gyroscope;
   Mat3 Q;
-  canonical_accelerometer((a.misalignment * a.scale.asDiagonal()).inverse(), s.acc_T, s.acc_k, &Q);
-  canonical_gyroscope(Q.transpose() * (g.misalignment * g.scale.asDiagonal()).inverse(), s.gyro_T, s.gyro_k);
+  calibration::canonical_accelerometer((a.misalignment * a.scale.asDiagonal()).inverse(), s.acc_T, s.acc_k, &Q);
+  calibration::canonical_gyroscope(Q.transpose() * (g.misalignment * g.scale.asDiagonal()).inverse(), s.gyro_T,
+                                   s.gyro_k);
   s.acc_b = a.bias;
   s.gyro_b = g.bias;
   return s;
@@ -51,7 +52,8 @@ inline double bias_walk_sigma(const sim::InertialSensorErrors& e, double duratio
 }
 
 /// Errors (fit − truth) in the order of AccelerometerCalibration::sigma.
-inline Eigen::Matrix<double, 9, 1> acc_errors(const AccelerometerCalibration& c, const SimulatedCalibration& s) {
+inline Eigen::Matrix<double, 9, 1> acc_errors(const calibration::AccelerometerCalibration& c,
+                                              const SimulatedCalibration& s) {
   Eigen::Matrix<double, 9, 1> e;
   e << c.misalignment(0, 1) - s.acc_T(0, 1), c.misalignment(0, 2) - s.acc_T(0, 2), c.misalignment(1, 2) - s.acc_T(1, 2),
       c.scale - s.acc_k, c.bias - s.acc_b;
@@ -59,11 +61,12 @@ inline Eigen::Matrix<double, 9, 1> acc_errors(const AccelerometerCalibration& c,
 }
 
 /// Errors in the order of GyroscopeCalibration::sigma (plus the bias, not in sigma).
-inline Eigen::Matrix<double, 9, 1> gyro_errors(const GyroscopeCalibration& c, const SimulatedCalibration& s) {
+inline Eigen::Matrix<double, 9, 1> gyro_errors(const calibration::GyroscopeCalibration& c,
+                                               const SimulatedCalibration& s) {
   Eigen::Matrix<double, 9, 1> e;
   const Mat3 d = c.misalignment - s.gyro_T;
   e << d(0, 1), d(0, 2), d(1, 0), d(1, 2), d(2, 0), d(2, 1), c.scale - s.gyro_k;
   return e;
 }
 
-}  // namespace antpose::calibration::test
+}  // namespace antpose::test

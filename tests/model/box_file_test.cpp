@@ -12,7 +12,7 @@ namespace antpose::model {
 namespace {
 using ::testing::HasSubstr;
 
-Iso3 known_pose() {
+Iso3 known_box_pose() {
   Iso3 T_mesh_antenna = Iso3::Identity();
   T_mesh_antenna.linear() = exp_so3(Vec3(0.3, -1.2, 2.0));
   T_mesh_antenna.translation() = Vec3(1.5, -2.0, 0.7);
@@ -29,11 +29,11 @@ std::string box_text(const std::array<Vec3, 8>& c, const std::array<int, 8>& ord
 }
 
 TEST(BoxFile, RecoversKnownPoseAndSize) {
-  const auto corners = box_corners(kSize, known_pose());
+  const auto corners = box_corners(kSize, known_box_pose());
   // Any order, comments and blank lines.
   const std::string text = "# fitted by hand\n\n" + box_text(corners, {7, 2, 0, 5, 1, 6, 3, 4}) + "   # end\n";
   const AntennaBox box = parse_box_file(text, "box.txt");
-  const Iso3 expected = known_pose().inverse();
+  const Iso3 expected = known_box_pose().inverse();
   EXPECT_LT((box.T_antenna_mesh.linear() - expected.linear()).cwiseAbs().maxCoeff(), 1e-9);
   EXPECT_LT((box.T_antenna_mesh.translation() - expected.translation()).cwiseAbs().maxCoeff(), 1e-9);
   EXPECT_LT((box.size_m - kSize).cwiseAbs().maxCoeff(), 1e-9);
@@ -46,21 +46,21 @@ TEST(BoxFile, RecoversKnownPoseAndSize) {
 }
 
 TEST(BoxFile, ReadsMillimetresAndTheWrittenFormat) {
-  std::array<Vec3, 8> corners = box_corners(kSize, known_pose());
+  std::array<Vec3, 8> corners = box_corners(kSize, known_box_pose());
   for (auto& c : corners) c *= 1000;
   test::TempDir dir;
   test::write_file(dir / "box.txt", format_box_file(corners));
   const AntennaBox box = read_box_file(dir / "box.txt", Units::kMillimetres);
-  EXPECT_LT((box.T_antenna_mesh.translation() - known_pose().inverse().translation()).norm(), 1e-9);
+  EXPECT_LT((box.T_antenna_mesh.translation() - known_box_pose().inverse().translation()).norm(), 1e-9);
   EXPECT_LT((box.size_m - kSize).norm(), 1e-9);
 }
 
 TEST(BoxFile, ToleratesHandPickedCorners) {
-  auto corners = box_corners(kSize, known_pose());
+  auto corners = box_corners(kSize, known_box_pose());
   corners[2] += Vec3(0.002, -0.001, 0.0015);  // a few millimetres off
   corners[5] += Vec3(-0.001, 0.002, 0.0);
   const AntennaBox box = parse_box_file(box_text(corners), "box.txt");
-  EXPECT_LT(rad2deg(rotation_distance(box.T_antenna_mesh.linear(), known_pose().inverse().linear())), 0.5);
+  EXPECT_LT(rad2deg(rotation_distance(box.T_antenna_mesh.linear(), known_box_pose().inverse().linear())), 0.5);
   EXPECT_NEAR(box.T_antenna_mesh.linear().determinant(), 1.0, 1e-12);
 }
 
@@ -87,9 +87,9 @@ TEST(BoxFile, BadLinesNameFileAndLine) {
 }
 
 TEST(BoxFile, CornersThatAreNotABox) {
-  auto c = box_corners(kSize, known_pose());
+  auto c = box_corners(kSize, known_box_pose());
   auto moved = c;
-  moved[2] += known_pose().linear() * Vec3(0.05, 0, 0);  // C 5 cm off to the right
+  moved[2] += known_box_pose().linear() * Vec3(0.05, 0, 0);  // C 5 cm off to the right
   const std::string message = test::input_error([&] { parse_box_file(box_text(moved), "box.txt"); });
   EXPECT_THAT(message, HasSubstr("box.txt: not a box: edges AD and BC should be parallel"));
   EXPECT_THAT(message, HasSubstr("check corners B and C (lines 2 and 3)"));
@@ -129,7 +129,7 @@ TEST(BoxFile, SkewedBoxIsNotRectangular) {
 }
 
 TEST(BoxFile, MirroredBoxSaysWhichLabelsSeemSwapped) {
-  const auto c = box_corners(kSize, known_pose());
+  const auto c = box_corners(kSize, known_box_pose());
   // Left and right exchanged: A↔B, C↔D, E↔F, G↔H.
   const std::array<Vec3, 8> lr = {c[1], c[0], c[3], c[2], c[5], c[4], c[7], c[6]};
   const std::string message = test::input_error([&] { parse_box_file(box_text(lr), "box.txt"); });

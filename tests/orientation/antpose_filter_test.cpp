@@ -19,8 +19,8 @@ using test::ErrorStats;
 using test::Sim;
 
 // This file's simulations use their own seed.
-Sim simulate(sim::Trajectory trajectory, sim::PhoneModel phone = sim::PhoneModel::ideal(),
-             std::vector<sim::MagneticDisturbance> disturbances = {}) {
+Sim simulate_own_seed(sim::Trajectory trajectory, sim::PhoneModel phone = sim::PhoneModel::ideal(),
+                      std::vector<sim::MagneticDisturbance> disturbances = {}) {
   return test::simulate(std::move(trajectory), std::move(phone), std::move(disturbances), 7);
 }
 
@@ -36,7 +36,7 @@ double baseline_end_error(const char* name, const Sim& baseline, double last_s) 
 }
 
 TEST(AntposeFilter, IdealDataBelowATenthOfADegree) {
-  const Sim s = simulate(sim::random_rotations(6, 2.0, 2.0, 21));
+  const Sim s = simulate_own_seed(sim::random_rotations(6, 2.0, 2.0, 21));
   Diagnostics diag;
   const ImuData data = imu_data_from_capture(s.capture, diag);
   const double end = s.sim.trajectory.duration();
@@ -57,7 +57,7 @@ TEST(AntposeFilter, LargeGyroscopeBiasEstimated) {
   phone.gyroscope.noise_density = deg2rad(0.007);
   const Vec3 bias = Vec3(deg2rad(6.0), deg2rad(-3.0), deg2rad(2.0));
   phone.gyroscope.bias = bias;
-  const Sim s = simulate(sim::random_rotations(8, 3.0, 2.0, 5).hold(10.0), phone);
+  const Sim s = simulate_own_seed(sim::random_rotations(8, 3.0, 2.0, 5).hold(10.0), phone);
   Diagnostics diag;
   const ImuData data = imu_data_from_capture(s.capture, diag);
   EXPECT_TRUE(diag.mentions("bias"));  // the data check warns
@@ -79,7 +79,7 @@ TEST(AntposeFilter, LargeGyroscopeBiasEstimated) {
 }
 
 TEST(AntposeFilter, OneSecondGyroscopeGap) {
-  Sim s = simulate(sim::random_rotations(4, 3.0, 2.0, 9).hold(15.0), sim::PhoneModel::typical());
+  Sim s = simulate_own_seed(sim::random_rotations(4, 3.0, 2.0, 9).hold(15.0), sim::PhoneModel::typical());
   const Sim baseline = s;
   test::cut_stream(s.capture, "gyroscope", 6.0, 7.0);
   Diagnostics diag;
@@ -95,7 +95,7 @@ TEST(AntposeFilter, OneSecondGyroscopeGap) {
 }
 
 TEST(AntposeFilter, SaturatedGyroscope) {
-  Sim s = simulate(sim::random_rotations(5, 3.0, 0.6, 4).hold(30.0), sim::PhoneModel::typical());
+  Sim s = simulate_own_seed(sim::random_rotations(5, 3.0, 0.6, 4).hold(30.0), sim::PhoneModel::typical());
   const Sim baseline = s;
   Stream& g = s.capture.streams.at("gyroscope");
   g.values = g.values.cwiseMax(-2.5).cwiseMin(2.5);  // rad/s: the fast moves exceed it
@@ -114,8 +114,9 @@ TEST(AntposeFilter, SaturatedGyroscope) {
 
 TEST(AntposeFilter, MagnetNearThePhoneRejected) {
   const sim::MagneticDisturbance magnet{10.0, 15.0, Vec3(80.0, 0.0, 30.0)};
-  const Sim s = simulate(sim::random_rotations(5, 4.0, 2.0, 3).hold(20.0), sim::PhoneModel::typical(), {magnet});
-  const Sim baseline = simulate(sim::random_rotations(5, 4.0, 2.0, 3).hold(20.0), sim::PhoneModel::typical());
+  const Sim s =
+      simulate_own_seed(sim::random_rotations(5, 4.0, 2.0, 3).hold(20.0), sim::PhoneModel::typical(), {magnet});
+  const Sim baseline = simulate_own_seed(sim::random_rotations(5, 4.0, 2.0, 3).hold(20.0), sim::PhoneModel::typical());
   Diagnostics diag;
   const ImuData data = imu_data_from_capture(s.capture, diag);
   const double end = s.sim.trajectory.duration();
@@ -134,7 +135,7 @@ TEST(AntposeFilter, MagnetNearThePhoneRejected) {
 }
 
 TEST(AntposeFilter, NonFiniteSamplesSkippedWithWarning) {
-  Sim s = simulate(sim::random_rotations(3, 2.0, 2.0, 3));
+  Sim s = simulate_own_seed(sim::random_rotations(3, 2.0, 2.0, 3));
   Diagnostics diag;
   ImuData data = imu_data_from_capture(s.capture, diag);
   data.accelerometer.v[100] = Vec3(std::nan(""), 0.0, 0.0);
@@ -146,7 +147,7 @@ TEST(AntposeFilter, NonFiniteSamplesSkippedWithWarning) {
 }
 
 TEST(AntposeFilter, SixDofWithoutMagnetometer) {
-  Sim s = simulate(sim::random_rotations(3, 2.0, 2.0, 3));
+  Sim s = simulate_own_seed(sim::random_rotations(3, 2.0, 2.0, 3));
   s.capture.streams.erase("magnetometer");
   Diagnostics diag;
   const ImuData data = imu_data_from_capture(s.capture, diag);

@@ -12,7 +12,7 @@
 #include "antpose/orientation/estimator.hpp"
 #include "antpose/sim/imu_simulator.hpp"
 
-namespace antpose::orientation::test {
+namespace antpose::test {
 
 struct Sim {
   sim::ImuSimulation sim;
@@ -36,7 +36,8 @@ struct ErrorStats {
 };
 
 /// Angle between track and simulated truth over the track samples in [t0, t1].
-inline ErrorStats errors(const OrientationTrack& track, const sim::Trajectory& truth, double t0, double t1) {
+inline ErrorStats errors(const orientation::OrientationTrack& track, const sim::Trajectory& truth, double t0,
+                         double t1) {
   ErrorStats e;
   double sum = 0.0;
   std::size_t n = 0;
@@ -63,4 +64,4 @@ inline void cut_stream(Capture& capture, const std::string& name, double t0, dou
   stream.t = std::move(t);
 }
 
-}  // namespace antpose::orientation::test
+}  // namespace antpose::test

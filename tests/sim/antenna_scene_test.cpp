@@ -22,11 +22,15 @@
 #include "antpose/sim/board_texture.hpp"
 #include "antpose/sim/capture_simulator.hpp"
 #include "antpose/sim/photo_simulator.hpp"
+#include "sim/truth_yaml.hpp"
 #include "support/test_support.hpp"
 
 namespace antpose::sim {
 namespace {
 namespace fs = std::filesystem;
+using test::intrinsics_of;
+using test::mat;
+using test::vec;
 using ::testing::HasSubstr;
 
 camera::CameraIntrinsics test_camera() {
@@ -249,24 +253,6 @@ TEST(SimDipole, FieldIsTheDipoleFormulaAndTheMastDisturbanceHitsItsTarget) {
   EXPECT_LT(std::abs(north_shift(dipoles, field, 3.0 * p_ref)), std::abs(north_shift(dipoles, field, p_ref)) / 5);
   EXPECT_GT(std::abs(north_shift(dipoles, field, Vec3(2.0, 6.0, 1.5)) - north_shift(dipoles, field, p_ref)),
             deg2rad(0.2));
-}
-
-Mat3 mat(const YAML::Node& rows) {
-  Mat3 M;
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) M(i, j) = rows[i][j].as<double>();
-  return M;
-}
-Vec3 vec(const YAML::Node& n) { return {n[0].as<double>(), n[1].as<double>(), n[2].as<double>()}; }
-
-camera::CameraIntrinsics intrinsics_of(const YAML::Node& device) {
-  const auto c = device["camera"];
-  camera::CameraIntrinsics K;
-  K.width = c["width_px"].as<int>(), K.height = c["height_px"].as<int>();
-  K.fx = c["fx_px"].as<double>(), K.fy = c["fy_px"].as<double>(), K.cx = c["cx_px"].as<double>(),
-  K.cy = c["cy_px"].as<double>();
-  for (std::size_t i = 0; i < 5; ++i) K.distortion[i] = c["distortion"][i].as<double>();
-  return K;
 }
 
 CaptureScenario small_antenna_scenario(std::uint64_t seed) {

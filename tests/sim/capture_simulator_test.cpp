@@ -14,19 +14,15 @@
 #include "antpose/io/capture.hpp"
 #include "antpose/io/text_file.hpp"
 #include "antpose/sim/capture_simulator.hpp"
+#include "sim/truth_yaml.hpp"
 #include "support/test_support.hpp"
 
 namespace antpose::sim {
 namespace {
 namespace fs = std::filesystem;
-
-Mat3 mat(const YAML::Node& rows) {
-  Mat3 M;
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) M(i, j) = rows[i][j].as<double>();
-  return M;
-}
-Vec3 vec(const YAML::Node& n) { return {n[0].as<double>(), n[1].as<double>(), n[2].as<double>()}; }
+using test::intrinsics_of;
+using test::mat;
+using test::vec;
 
 // q_world_device of the truth stream at t, by slerp between the neighbouring samples.
 Mat3 truth_at(const Stream& truth, double t) {
@@ -36,15 +32,6 @@ Mat3 truth_at(const Stream& truth, double t) {
   auto q = [&](Eigen::Index i) { return Quat(truth.values(i, 0), truth.values(i, 1), truth.values(i, 2), truth.values(i, 3)); };
   const double f = (t - truth.t[static_cast<std::size_t>(i0)]) / (truth.t[static_cast<std::size_t>(i1)] - truth.t[static_cast<std::size_t>(i0)]);
   return q(i0).slerp(f, q(i1)).toRotationMatrix();
-}
-
-camera::CameraIntrinsics intrinsics_of(const YAML::Node& device) {
-  const auto c = device["camera"];
-  camera::CameraIntrinsics K;
-  K.width = c["width_px"].as<int>(), K.height = c["height_px"].as<int>();
-  K.fx = c["fx_px"].as<double>(), K.fy = c["fy_px"].as<double>(), K.cx = c["cx_px"].as<double>(), K.cy = c["cy_px"].as<double>();
-  for (std::size_t i = 0; i < 5; ++i) K.distortion[i] = c["distortion"][i].as<double>();
-  return K;
 }
 
 // One joint-calibration capture shared by the tests below (rendering is the slow part).

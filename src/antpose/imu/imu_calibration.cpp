@@ -171,9 +171,7 @@ std::string format_imu_calibration(const ImuCalibration& c) {
     if (c.gyro_residual_rms_deg) imu["gyroscope"]["residual_rms_deg"] = io::format_number(*c.gyro_residual_rms_deg);
   }
   if (!imu.IsMap() || imu.size() == 0) d["imu"] = YAML::Node(YAML::NodeType::Map);
-  YAML::Emitter out;
-  out << d;
-  return std::string(out.c_str()) + "\n";
+  return io::yaml_document(d);
 }
 
 void write_imu_calibration(const ImuCalibration& calibration, const fs::path& file) {

@@ -12,6 +12,7 @@
 #include "antpose/io/text_file.hpp"
 #include "antpose/io/time.hpp"
 #include "antpose/io/units.hpp"
+#include "antpose/io/yaml_util.hpp"
 
 namespace antpose {
 namespace fs = std::filesystem;
@@ -403,9 +404,7 @@ void validate_capture(Capture& c, const fs::path& folder, Diagnostics& diagnosti
 
 void write_capture(const Capture& c, const fs::path& folder, const CaptureWriteOptions& options) {
   io::write_folder_atomic(folder, options.overwrite, [&](const fs::path& tmp) {
-    YAML::Emitter yaml;
-    yaml << metadata_yaml(c);
-    io::write_text_atomic(tmp / "capture.yaml", std::string(yaml.c_str()) + "\n");
+    io::write_text_atomic(tmp / "capture.yaml", io::yaml_document(metadata_yaml(c)));
     for (const auto& [name, s] : c.streams) io::write_text_atomic(stream_path(tmp, s), stream_csv(s));
     if (!c.shots.empty()) {
       io::write_text_atomic(tmp / "shots.csv", shots_csv(c));

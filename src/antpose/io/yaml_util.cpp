@@ -85,6 +85,12 @@ YAML::Node yaml_required(const YAML::Node& parent, const char* key, const fs::pa
 
 YAML::Node yaml_scalar(double v) { return YAML::Node(format_number(v)); }
 
+std::string yaml_document(const YAML::Node& node) {
+  YAML::Emitter out;
+  out << node;
+  return std::string(out.c_str()) + "\n";
+}
+
 YAML::Node yaml_flow_vector(const Vec3& v) {
   YAML::Node n(YAML::NodeType::Sequence);
   for (int k = 0; k < 3; ++k) n.push_back(format_number(v[k]));

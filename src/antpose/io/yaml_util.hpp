@@ -42,5 +42,7 @@ YAML::Node yaml_required(const YAML::Node& parent, const char* key, const std::f
 YAML::Node yaml_scalar(double v);
 YAML::Node yaml_flow_vector(const Vec3& v);
 YAML::Node yaml_flow_matrix(const Mat3& m);
+/// A node emitted as a YAML document, with its final newline.
+std::string yaml_document(const YAML::Node& node);
 
 }  // namespace antpose::io

@@ -10,14 +10,11 @@
 
 #include "antpose/core/error.hpp"
 #include "antpose/sim/board_texture.hpp"
+#include "antpose/sim/random.hpp"
 
 namespace antpose::sim {
 
 namespace {
-
-double uniform(std::mt19937_64& rng, double lo, double hi) {
-  return std::uniform_real_distribution<double>(lo, hi)(rng);
-}
 
 // --- procedural noise (value noise on an integer lattice, hashed: no tables, thread-safe) ---
 

@@ -18,21 +18,14 @@
 #include "antpose/io/csv.hpp"
 #include "antpose/io/yaml_util.hpp"
 #include "antpose/sim/board_texture.hpp"
+#include "antpose/sim/random.hpp"
 
 namespace antpose::sim {
 namespace fs = std::filesystem;
 
 namespace {
 
-std::mt19937_64 make_rng(std::uint64_t seed, std::uint64_t stream) {
-  std::seed_seq seq{static_cast<std::uint32_t>(seed), static_cast<std::uint32_t>(seed >> 32),
-                    static_cast<std::uint32_t>(stream), 0xca9u};
-  return std::mt19937_64(seq);
-}
-
-double uniform(std::mt19937_64& rng, double lo, double hi) {
-  return std::uniform_real_distribution<double>(lo, hi)(rng);
-}
+constexpr std::uint32_t kCaptureStreams = 0xca9u;  // make_rng's salt
 
 Vec3 random_unit(std::mt19937_64& rng) {
   std::normal_distribution<double> n(0.0, 1.0);
@@ -69,12 +62,7 @@ Mat3 look_rotation(const Vec3& forward, const Vec3& down, double roll) {
 
 using io::yaml_flow_matrix;
 using io::yaml_flow_vector;
-YAML::Node num(double v) { return io::yaml_scalar(v); }
-std::string emit(const YAML::Node& node) {
-  YAML::Emitter out;
-  out << node;
-  return std::string(out.c_str()) + "\n";
-}
+using io::yaml_scalar;
 
 // The board's printed area seen from a camera pose: every corner of extent() widened by
 // `margin_m` projects inside the image with `border_px` to spare.
@@ -355,7 +343,7 @@ SimulatedDevice make_device(const DeviceOptions& o, std::uint64_t seed) {
     throw std::invalid_argument(fmt::format("time offset {} s is outside ±1 s", *o.time_offset_s));
   if (o.supersampling < 1 || o.supersampling > 8)
     throw std::invalid_argument(fmt::format("supersampling {} is outside 1..8", o.supersampling));
-  auto rng = make_rng(seed, 0xde71ce);
+  auto rng = make_rng(seed, 0xde71ce, kCaptureStreams);
   SimulatedDevice d;
   if (o.phone == "ideal")
     d.phone = PhoneModel::ideal();
@@ -507,7 +495,7 @@ SimulatedCapture simulate_capture(const CaptureScenario& sc, const fs::path& scr
   out.declination_deg = rad2deg(field.declination);
   const Vec3 field_world_uT = rot_z(field.declination) * field.field_enu_uT;
 
-  auto rng = make_rng(sc.seed, 0x5ce7e);
+  auto rng = make_rng(sc.seed, 0x5ce7e, kCaptureStreams);
   const bool joint = sc.scenario == Scenario::kJointCalibration;
   const bool has_board = sc.scenario != Scenario::kPlanes;
   Trajectory tr;
@@ -886,7 +874,7 @@ SimulatedCapture simulate_capture(const CaptureScenario& sc, const fs::path& scr
     // The thesis's reference instruments (§5.4.3): a level (±0.2°) for G lines, a compass
     // (±1.5°, magnetic north) for N lines; errors uniform within those bounds. N lines only for
     // axes more than 10° from the vertical (a compass cannot read a near-vertical axis).
-    auto ref_rng = make_rng(sc.seed, 0x7ef);
+    auto ref_rng = make_rng(sc.seed, 0x7ef, kCaptureStreams);
     std::string csv = "placement,axis,ref,angle_deg\n";
     for (const auto& pl : out.placements)
       for (int a = 0; a < 3; ++a) {
@@ -937,10 +925,10 @@ std::string capture_device_yaml(const SimulatedDevice& d, const ImuSimulation& i
   YAML::Node cam;
   cam["width_px"] = K.width;
   cam["height_px"] = K.height;
-  cam["fx_px"] = num(K.fx);
-  cam["fy_px"] = num(K.fy);
-  cam["cx_px"] = num(K.cx);
-  cam["cy_px"] = num(K.cy);
+  cam["fx_px"] = yaml_scalar(K.fx);
+  cam["fy_px"] = yaml_scalar(K.fy);
+  cam["cx_px"] = yaml_scalar(K.cx);
+  cam["cy_px"] = yaml_scalar(K.cy);
   YAML::Node dist;
   for (double k : K.distortion) dist.push_back(io::format_number(k));
   dist.SetStyle(YAML::EmitterStyle::Flow);
@@ -948,7 +936,7 @@ std::string capture_device_yaml(const SimulatedDevice& d, const ImuSimulation& i
   root["camera"] = cam;
   YAML::Node ci;
   ci["R_device_camera"] = yaml_flow_matrix(d.R_device_camera);
-  ci["mounting_error_deg"] = num(d.mounting_error_deg);
+  ci["mounting_error_deg"] = yaml_scalar(d.mounting_error_deg);
   // What an IMU calibration can recover: it defines the device frame by the accelerometer's own
   // axes, so the accelerometer's mounting rotation Q (R_device_calibrated) is invisible to it.
   {
@@ -962,28 +950,28 @@ std::string capture_device_yaml(const SimulatedDevice& d, const ImuSimulation& i
         "in its xy plane): R_calibrated_camera = R_device_calibratedᵀ R_device_camera";
   }
   ci["p_device_camera_m"] = yaml_flow_vector(d.p_device_camera);
-  ci["time_offset_s"] = num(d.time_offset_s);
+  ci["time_offset_s"] = yaml_scalar(d.time_offset_s);
   ci["time_offset_definition"] = "IMU-clock instant of a photo = shots.csv t + time_offset_s";
   root["camera_imu"] = ci;
   YAML::Node ph;
-  ph["exposure_s"] = num(d.sensor.exposure_s);
+  ph["exposure_s"] = yaml_scalar(d.sensor.exposure_s);
   ph["instant"] = "middle of the exposure (motion blur is centred on it)";
-  ph["blur_sigma_px"] = num(d.sensor.blur_sigma_px);
-  ph["noise_scale"] = num(d.sensor.noise_scale);
-  ph["full_well_e"] = num(d.sensor.full_well_e);
-  ph["read_noise_e"] = num(d.sensor.read_noise_e);
-  ph["gain"] = num(d.sensor.gain);
-  ph["gamma"] = num(d.sensor.gamma);
+  ph["blur_sigma_px"] = yaml_scalar(d.sensor.blur_sigma_px);
+  ph["noise_scale"] = yaml_scalar(d.sensor.noise_scale);
+  ph["full_well_e"] = yaml_scalar(d.sensor.full_well_e);
+  ph["read_noise_e"] = yaml_scalar(d.sensor.read_noise_e);
+  ph["gain"] = yaml_scalar(d.sensor.gain);
+  ph["gamma"] = yaml_scalar(d.sensor.gamma);
   ph["jpeg_quality"] = d.sensor.jpeg_quality;
   ph["supersampling"] = d.supersampling;
   root["photo"] = ph;
-  return emit(root);
+  return io::yaml_document(root);
 }
 
 std::string capture_scene_yaml(const SimulatedCapture& sim, const camera::BoardSpec& board) {
   YAML::Node root;
   root["world"] = "enu-magnetic";
-  root["declination_deg"] = num(sim.declination_deg);
+  root["declination_deg"] = yaml_scalar(sim.declination_deg);
   root["note"] =
       "true azimuth = magnetic azimuth + declination; rotations as rows; board frame of board.yaml (camera/board.hpp)";
   if (!sim.placements.empty()) {
@@ -991,7 +979,7 @@ std::string capture_scene_yaml(const SimulatedCapture& sim, const camera::BoardS
     b["type"] = camera::to_string(board.type);
     b["cols"] = board.cols;
     b["rows"] = board.rows;
-    b["square_m"] = num(board.square_m);
+    b["square_m"] = yaml_scalar(board.square_m);
     root["board"] = b;
   }
   for (const auto& pl : sim.placements) {
@@ -1020,9 +1008,10 @@ std::string capture_scene_yaml(const SimulatedCapture& sim, const camera::BoardS
     root["setting"] = to_string(at.layout.setting);
     YAML::Node mast;
     mast["p_world_base_m"] = yaml_flow_vector(Vec3::Zero());
-    mast["radius_m"] = num(at.layout.mast_radius_m);
-    mast["height_m"] = num(at.layout.mast_top_m);
-    if (at.layout.setting == AntennaSetting::kRooftop) mast["roof_above_street_m"] = num(at.layout.building_height_m);
+    mast["radius_m"] = yaml_scalar(at.layout.mast_radius_m);
+    mast["height_m"] = yaml_scalar(at.layout.mast_top_m);
+    if (at.layout.setting == AntennaSetting::kRooftop)
+      mast["roof_above_street_m"] = yaml_scalar(at.layout.building_height_m);
     root["mast"] = mast;
     for (std::size_t k = 0; k < at.layout.antennas.size(); ++k) {
       const SimAntenna& a = at.layout.antennas[k];
@@ -1030,22 +1019,22 @@ std::string capture_scene_yaml(const SimulatedCapture& sim, const camera::BoardS
       n["name"] = a.name;
       n["model"] = a.model_name;
       YAML::Node spec;
-      spec["width_m"] = num(a.spec.width_m);
-      spec["depth_m"] = num(a.spec.depth_m);
-      spec["height_m"] = num(a.spec.height_m);
-      spec["edge_radius_m"] = num(a.spec.edge_radius_m);
+      spec["width_m"] = yaml_scalar(a.spec.width_m);
+      spec["depth_m"] = yaml_scalar(a.spec.depth_m);
+      spec["height_m"] = yaml_scalar(a.spec.height_m);
+      spec["edge_radius_m"] = yaml_scalar(a.spec.edge_radius_m);
       spec["bracket"] = a.spec.bracket;
-      spec["bracket_width_m"] = num(a.spec.bracket_width_m);
-      spec["bracket_depth_m"] = num(a.spec.bracket_depth_m);
-      spec["bracket_height_m"] = num(a.spec.bracket_height_m);
+      spec["bracket_width_m"] = yaml_scalar(a.spec.bracket_width_m);
+      spec["bracket_depth_m"] = yaml_scalar(a.spec.bracket_depth_m);
+      spec["bracket_height_m"] = yaml_scalar(a.spec.bracket_height_m);
       spec["arc_segments"] = a.spec.arc_segments;
       n["panel"] = spec;
       n["R_world_antenna"] = yaml_flow_matrix(a.R_world_antenna);
       n["p_world_antenna_m"] = yaml_flow_vector(a.p_world_antenna);
-      n["azimuth_magnetic_deg"] = num(rad2deg(a.azimuth_magnetic));
-      n["azimuth_true_deg"] = num(rad2deg(wrap_2pi(a.azimuth_magnetic + decl)));
-      n["downtilt_deg"] = num(rad2deg(a.downtilt));
-      n["roll_deg"] = num(rad2deg(a.roll));
+      n["azimuth_magnetic_deg"] = yaml_scalar(rad2deg(a.azimuth_magnetic));
+      n["azimuth_true_deg"] = yaml_scalar(rad2deg(wrap_2pi(a.azimuth_magnetic + decl)));
+      n["downtilt_deg"] = yaml_scalar(rad2deg(a.downtilt));
+      n["roll_deg"] = yaml_scalar(rad2deg(a.roll));
       n["radome"] = to_string(at.radome);
       if (k < at.roi.size()) {
         YAML::Node roi;
@@ -1057,7 +1046,7 @@ std::string capture_scene_yaml(const SimulatedCapture& sim, const camera::BoardS
         roi.SetStyle(YAML::EmitterStyle::Flow);
         n["roi"] = roi;
       }
-      if (k < at.viewing_span_deg.size()) n["viewing_span_deg"] = num(at.viewing_span_deg[k]);
+      if (k < at.viewing_span_deg.size()) n["viewing_span_deg"] = yaml_scalar(at.viewing_span_deg[k]);
       if (k < at.visible_fraction.size()) {
         YAML::Node vis;
         for (const double f : at.visible_fraction[k]) vis.push_back(io::format_number(std::round(f * 1000.0) / 1000.0));
@@ -1117,16 +1106,16 @@ std::string capture_scene_yaml(const SimulatedCapture& sim, const camera::BoardS
     n["index"] = s.index;
     n["image"] = s.image;
     if (!s.placement.empty()) n["placement"] = s.placement;
-    n["t_true"] = num(s.t_true);
-    n["t"] = num(s.t_shot);
+    n["t_true"] = yaml_scalar(s.t_true);
+    n["t"] = yaml_scalar(s.t_shot);
     n["R_world_device"] = yaml_flow_matrix(s.R_world_device);
     n["p_world_device_m"] = yaml_flow_vector(s.p_world_device);
     n["R_world_camera"] = yaml_flow_matrix(s.R_world_camera);
     n["p_world_camera_m"] = yaml_flow_vector(s.p_world_camera);
-    n["angular_rate_deg_s"] = num(s.angular_rate_deg_s);
+    n["angular_rate_deg_s"] = yaml_scalar(s.angular_rate_deg_s);
     root["shots"].push_back(n);
   }
-  return emit(root);
+  return io::yaml_document(root);
 }
 
 }  // namespace antpose::sim

@@ -10,6 +10,7 @@
 
 #include "antpose/io/csv.hpp"
 #include "antpose/io/yaml_util.hpp"
+#include "antpose/sim/random.hpp"
 
 namespace antpose::sim {
 
@@ -51,11 +52,7 @@ Mat3 right_jacobian(const Vec3& theta) {
   return Mat3::Identity() - a * K + b * K * K;
 }
 
-std::mt19937_64 make_rng(std::uint64_t seed, std::uint64_t stream) {
-  std::seed_seq seq{static_cast<std::uint32_t>(seed), static_cast<std::uint32_t>(seed >> 32),
-                    static_cast<std::uint32_t>(stream), 0x5eedu};
-  return std::mt19937_64(seq);
-}
+constexpr std::uint32_t kImuStreams = 0x5eedu;  // make_rng's salt
 
 Vec3 normal3(std::mt19937_64& rng, double sigma = 1.0) {
   std::normal_distribution<double> n(0.0, sigma);
@@ -129,7 +126,7 @@ Stream inertial_stream(std::string name, const InertialSensorErrors& e, double d
 
 using io::yaml_flow_matrix;
 using io::yaml_flow_vector;
-YAML::Node num(double v) { return io::yaml_scalar(v); }
+using io::yaml_scalar;
 
 YAML::Node inertial_yaml(const InertialSensorErrors& e, const char* unit) {
   YAML::Node n;
@@ -137,17 +134,11 @@ YAML::Node inertial_yaml(const InertialSensorErrors& e, const char* unit) {
   n["misalignment"] = yaml_flow_matrix(e.misalignment);
   n["scale"] = yaml_flow_vector(e.scale);
   n["bias"] = yaml_flow_vector(e.bias);
-  n["noise_density"] = num(e.noise_density);
-  n["bias_random_walk"] = num(e.bias_random_walk);
-  n["rate_hz"] = num(e.rate_hz);
-  n["rate_jitter_s"] = num(e.rate_jitter_s);
+  n["noise_density"] = yaml_scalar(e.noise_density);
+  n["bias_random_walk"] = yaml_scalar(e.bias_random_walk);
+  n["rate_hz"] = yaml_scalar(e.rate_hz);
+  n["rate_jitter_s"] = yaml_scalar(e.rate_jitter_s);
   return n;
-}
-
-std::string emit(const YAML::Node& node) {
-  YAML::Emitter out;
-  out << node;
-  return std::string(out.c_str()) + "\n";
 }
 
 }  // namespace
@@ -286,7 +277,7 @@ Trajectory& Trajectory::move_to(const Mat3& R_world_device, const Vec3& p_world,
 Trajectory& Trajectory::with_tremor(double rotation_rms_rad, double translation_rms_m, std::uint64_t seed) {
   if (!(rotation_rms_rad >= 0.0) || !(translation_rms_m >= 0.0))
     throw std::invalid_argument("Trajectory::with_tremor: amplitudes must be >= 0");
-  auto rng = make_rng(seed, 0x7e);
+  auto rng = make_rng(seed, 0x7e, kImuStreams);
   std::uniform_real_distribution<double> phase(0.0, 2.0 * std::numbers::pi);
   // Per band: (variance fraction, lowest and highest frequency in Hz, number of sinusoids).
   struct Band {
@@ -452,7 +443,7 @@ std::vector<Mat3> calibration_poses() {
 
 Trajectory random_rotations(std::size_t count, double hold_s, double move_s, std::uint64_t seed) {
   if (count == 0) throw std::invalid_argument("random_rotations: count must be positive");
-  auto rng = make_rng(seed, 0x40);
+  auto rng = make_rng(seed, 0x40, kImuStreams);
   std::vector<Mat3> poses(count);
   for (auto& R : poses) R = uniform_rotation(rng);
   return static_poses(poses, hold_s, move_s);
@@ -461,7 +452,7 @@ Trajectory random_rotations(std::size_t count, double hold_s, double move_s, std
 Trajectory tumble(double duration_s, double move_s, std::uint64_t seed) {
   check_duration(duration_s, "tumble");
   check_duration(move_s, "tumble");
-  auto rng = make_rng(seed, 0x70);
+  auto rng = make_rng(seed, 0x70, kImuStreams);
   Trajectory tr;
   tr.hold(uniform_rotation(rng), 1.0);
   while (tr.duration() + move_s + 1.0 <= duration_s || tr.duration() <= 1.0)
@@ -516,7 +507,8 @@ Capture simulate_imu(const ImuSimulation& sim) {
   c.site = sim.site;
   c.truth_world = sim.truth_world;
 
-  auto rng_acc = make_rng(sim.seed, 1), rng_gyr = make_rng(sim.seed, 2), rng_mag = make_rng(sim.seed, 3);
+  auto rng_acc = make_rng(sim.seed, 1, kImuStreams), rng_gyr = make_rng(sim.seed, 2, kImuStreams),
+       rng_mag = make_rng(sim.seed, 3, kImuStreams);
   c.streams.emplace(
       std::string(streams::kAccelerometer),
       inertial_stream(std::string(streams::kAccelerometer), sim.phone.accelerometer, T, rng_acc, [&](double t) {
@@ -580,18 +572,18 @@ std::string device_yaml(const ImuSimulation& sim) {
   mag["unit"] = "uT";
   mag["hard_iron_uT"] = yaml_flow_vector(sim.phone.magnetometer.hard_iron_uT);
   mag["soft_iron"] = yaml_flow_matrix(sim.phone.magnetometer.soft_iron);
-  mag["noise_uT"] = num(sim.phone.magnetometer.noise_uT);
-  mag["rate_hz"] = num(sim.phone.magnetometer.rate_hz);
-  mag["rate_jitter_s"] = num(sim.phone.magnetometer.rate_jitter_s);
+  mag["noise_uT"] = yaml_scalar(sim.phone.magnetometer.noise_uT);
+  mag["rate_hz"] = yaml_scalar(sim.phone.magnetometer.rate_hz);
+  mag["rate_jitter_s"] = yaml_scalar(sim.phone.magnetometer.rate_jitter_s);
   root["magnetometer"] = mag;
   root["field_world_uT"] = yaml_flow_vector(sim.field_world_uT);
-  root["gravity"] = num(sim.gravity);
+  root["gravity"] = yaml_scalar(sim.gravity);
   root["earth_rotation"] = sim.earth_rotation;
   YAML::Node dist(YAML::NodeType::Sequence);
   for (const auto& d : sim.disturbances) {
     YAML::Node n;
-    n["t0"] = num(d.t0);
-    n["t1"] = num(d.t1);
+    n["t0"] = yaml_scalar(d.t0);
+    n["t1"] = yaml_scalar(d.t1);
     n["extra_world_uT"] = yaml_flow_vector(d.extra_world_uT);
     dist.push_back(n);
   }
@@ -607,7 +599,7 @@ std::string device_yaml(const ImuSimulation& sim) {
     root["dipoles"] = dip;
     root["dipoles_model"] = "B += 1e-7 (3 r^ (r^.m) - m) / |r|^3 T at the device position, r = p_device - p_dipole";
   }
-  return emit(root);
+  return io::yaml_document(root);
 }
 
 std::string contact_scene_yaml(const ContactTruth& truth) {
@@ -616,12 +608,12 @@ std::string contact_scene_yaml(const ContactTruth& truth) {
   antenna["name"] = "antenna";
   antenna["R_world_antenna"] = yaml_flow_matrix(truth.R_world_antenna);
   if (att.azimuth) {
-    antenna["azimuth_deg"] = num(rad2deg(*att.azimuth));
-    antenna["magnetic_azimuth_deg"] = num(rad2deg(wrap_2pi(*att.azimuth - truth.declination)));
+    antenna["azimuth_deg"] = yaml_scalar(rad2deg(*att.azimuth));
+    antenna["magnetic_azimuth_deg"] = yaml_scalar(rad2deg(wrap_2pi(*att.azimuth - truth.declination)));
   }
-  antenna["downtilt_deg"] = num(rad2deg(att.downtilt));
-  if (att.roll) antenna["roll_deg"] = num(rad2deg(*att.roll));
-  antenna["declination_deg"] = num(rad2deg(truth.declination));
+  antenna["downtilt_deg"] = yaml_scalar(rad2deg(att.downtilt));
+  if (att.roll) antenna["roll_deg"] = yaml_scalar(rad2deg(*att.roll));
+  antenna["declination_deg"] = yaml_scalar(rad2deg(truth.declination));
   YAML::Node root;
   root["antennas"].push_back(antenna);
   root["contact"]["placement"] = std::string(to_string(truth.placement));
@@ -630,7 +622,7 @@ std::string contact_scene_yaml(const ContactTruth& truth) {
   hold.push_back(io::format_number(truth.hold.second));
   hold.SetStyle(YAML::EmitterStyle::Flow);
   root["contact"]["hold"] = hold;
-  return emit(root);
+  return io::yaml_document(root);
 }
 
 Capture simulate_contact(ImuSimulation sim, const Mat3& R_world_antenna, ContactPlacement placement,

@@ -193,9 +193,7 @@ std::string format_device_profile(const DeviceProfile& profile) {
   } else {
     d.remove("camera_imu");
   }
-  YAML::Emitter out;
-  out << d;
-  return std::string(out.c_str()) + "\n";
+  return io::yaml_document(d);
 }
 
 void write_device_profile(const DeviceProfile& profile, const fs::path& file) {
