@@ -146,13 +146,19 @@ TEST(MeasureAcceptance, SimulatedSitesThroughTheCommandLine) {
   };
   std::vector<Site> sites;
   for (int k = 0; k < captures; ++k) sites.push_back({seed_base + k, k % 2 == 1, k % 3 == 2, 1 + (k / 2) % 3, false});
+  // Every regression site with ANTPOSE_MEASURE_REGRESSION=all (run it before changing the
+  // registration); everyday, to keep CI within its budget, the sites whose fault no shorter test
+  // guards: 3208 leaves for 3811, which takes the same path (other_positions) in half the time,
+  // and 3802 for BundleAdjust.FeaturesThatPullThePosesOffTheBoardAreLeftOut.
+  const char* regression_env = std::getenv("ANTPOSE_MEASURE_REGRESSION");
+  const bool all_regression = regression_env != nullptr && std::string(regression_env) == "all";
   if (!acceptance) {
     sites.push_back({3312, true, true, 3, true, 2});
     sites.push_back({3406, true, true, 3, true, 3});
-    sites.push_back({3208, true, false, 1, true});
+    if (all_regression) sites.push_back({3208, true, false, 1, true});
     sites.push_back({3711, false, false, 3, true, 2});
     sites.push_back({3811, false, false, 3, true, 3});
-    sites.push_back({3802, true, false, 1, true});
+    if (all_regression) sites.push_back({3802, true, false, 1, true});
     sites.push_back({5111, false, false, 3, true, 3});
     sites.push_back({5810, true, false, 2, true, 1});
   }
