@@ -333,7 +333,7 @@ RefinedPoses refine_camera_poses(const std::vector<PosedView>& views, const came
         out.covariance[v] = c * variance;
       }
     } else {
-      out.warnings.push_back("the pose covariances could not be computed (rank-deficient bundle adjustment)");
+      out.warnings.emplace_back("the pose covariances could not be computed (rank-deficient bundle adjustment)");
     }
   };
   auto problem = std::make_unique<ceres::Problem>();
