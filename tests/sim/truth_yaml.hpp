@@ -1,6 +1,5 @@
 // Shared by the simulator tests: the values of a simulated capture's truth files
-// (truth/device.yaml, truth/scene.yaml), read without the library's checks, which these files
-// need not pass through.
+// (truth/device.yaml, truth/scene.yaml).
 #pragma once
 
 #include <cstddef>
@@ -9,18 +8,14 @@
 
 #include "antpose/camera/camera_model.hpp"
 #include "antpose/geometry/rotation.hpp"
+#include "antpose/io/yaml_util.hpp"
 
 namespace antpose::test {
 
-/// A rotation written as three rows.
-inline Mat3 mat(const YAML::Node& rows) {
-  Mat3 M;
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) M(i, j) = rows[i][j].as<double>();
-  return M;
-}
-
-inline Vec3 vec(const YAML::Node& n) { return {n[0].as<double>(), n[1].as<double>(), n[2].as<double>()}; }
+/// A rotation written as three rows, and a vector: io's readers, which name the truth file's
+/// value in their message should the simulator write a bad one.
+inline Mat3 mat(const YAML::Node& rows) { return io::yaml_mat3(rows, "truth", "rotation"); }
+inline Vec3 vec(const YAML::Node& n) { return io::yaml_vec3(n, "truth", "vector"); }
 
 /// The camera of truth/device.yaml.
 inline camera::CameraIntrinsics intrinsics_of(const YAML::Node& device) {
