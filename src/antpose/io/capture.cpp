@@ -34,14 +34,12 @@ std::string stream_stem(const fs::path& file) {
 
 // --- capture.yaml -------------------------------------------------------------------------
 
-std::size_t yaml_line(const YAML::Node& node) { return node.Mark().is_null() ? 0 : static_cast<std::size_t>(node.Mark().line) + 1; }
-
 template <typename T>
 T yaml_as(const YAML::Node& node, const fs::path& file, std::string_view key, std::string_view expected) {
   try {
     return node.as<T>();
   } catch (const YAML::Exception&) {
-    throw InputError(file, yaml_line(node),
+    throw InputError(file, io::line_of(node),
                      fmt::format("'{}' is '{}', expected {}", key, node.IsScalar() ? node.Scalar() : "(not a scalar)", expected));
   }
 }
@@ -49,7 +47,7 @@ T yaml_as(const YAML::Node& node, const fs::path& file, std::string_view key, st
 std::string yaml_choice(const YAML::Node& node, const fs::path& file, std::string_view key, const std::set<std::string>& allowed) {
   const auto value = yaml_as<std::string>(node, file, key, "a name");
   if (!allowed.contains(value))
-    throw InputError(file, yaml_line(node), fmt::format("{} '{}' is unknown; expected one of {}", key, value, fmt::join(allowed, ", ")));
+    throw InputError(file, io::line_of(node), fmt::format("{} '{}' is unknown; expected one of {}", key, value, fmt::join(allowed, ", ")));
   return value;
 }
 
@@ -63,16 +61,16 @@ bool is_iso_date(std::string_view s) {
 }
 
 Site parse_site(const YAML::Node& node, const fs::path& file) {
-  if (!node.IsMap()) throw InputError(file, yaml_line(node), "'site' must be a map with lat_deg, lon_deg, alt_m, date");
+  if (!node.IsMap()) throw InputError(file, io::line_of(node), "'site' must be a map with lat_deg, lon_deg, alt_m, date");
   Site site;
   auto number = [&](const char* key, double lo, double hi, bool required, double fallback) {
     if (!node[key]) {
-      if (required) throw InputError(file, yaml_line(node), fmt::format("site: '{}' is missing", key));
+      if (required) throw InputError(file, io::line_of(node), fmt::format("site: '{}' is missing", key));
       return fallback;
     }
     const double v = yaml_as<double>(node[key], file, fmt::format("site.{}", key), "a number");
     if (!std::isfinite(v) || v < lo || v > hi)
-      throw InputError(file, yaml_line(node[key]), fmt::format("site.{} = {} is out of range, expected [{}, {}]", key, v, lo, hi));
+      throw InputError(file, io::line_of(node[key]), fmt::format("site.{} = {} is out of range, expected [{}, {}]", key, v, lo, hi));
     return v;
   };
   site.lat_deg = number("lat_deg", -90.0, 90.0, true, 0.0);
@@ -82,7 +80,7 @@ Site parse_site(const YAML::Node& node, const fs::path& file) {
   if (node["date"]) {
     site.date = yaml_as<std::string>(node["date"], file, "site.date", "a date YYYY-MM-DD");
     if (!is_iso_date(site.date))
-      throw InputError(file, yaml_line(node["date"]), fmt::format("site.date '{}' is not a date, expected YYYY-MM-DD", site.date));
+      throw InputError(file, io::line_of(node["date"]), fmt::format("site.date '{}' is not a date, expected YYYY-MM-DD", site.date));
   }
   return site;
 }
@@ -98,18 +96,18 @@ void parse_metadata(Capture& c, const fs::path& file) {
   if (!m["format"]) throw InputError(file, "no 'format' key: not an antpose capture (expected 'format: antpose-capture')");
   const auto format = yaml_as<std::string>(m["format"], file, "format", kFormatName);
   if (format != kFormatName)
-    throw InputError(file, yaml_line(m["format"]), fmt::format("unknown format '{}', expected '{}'", format, kFormatName));
+    throw InputError(file, io::line_of(m["format"]), fmt::format("unknown format '{}', expected '{}'", format, kFormatName));
   if (!m["version"]) throw InputError(file, "no 'version' key (expected 'version: 1')");
   const int version = yaml_as<int>(m["version"], file, "version", "an integer");
   if (version < 1 || version > Capture::kFormatVersion)
-    throw InputError(file, yaml_line(m["version"]),
+    throw InputError(file, io::line_of(m["version"]),
                      fmt::format("format version {} is not supported; this antpose reads versions 1 to {}", version,
                                  Capture::kFormatVersion));
   if (m["kind"]) c.kind = yaml_choice(m["kind"], file, "kind", kKinds);
   if (m["time_origin"] && !m["time_origin"].IsNull()) {
     c.time_origin = yaml_as<std::string>(m["time_origin"], file, "time_origin", "an ISO-8601 UTC instant");
     if (!io::parse_utc_iso8601(*c.time_origin))
-      throw InputError(file, yaml_line(m["time_origin"]),
+      throw InputError(file, io::line_of(m["time_origin"]),
                        fmt::format("time_origin '{}' is not an ISO-8601 UTC instant, expected e.g. 2014-01-04T11:34:44.114Z",
                                    *c.time_origin));
   }

@@ -1134,6 +1134,12 @@ OutlineFit fit_outline(AntennaMeasurement& m, const model::AntennaModel& model, 
             : fmt::format("to within its profile's {:.0f}° step", options.held_yaw_step_deg)));
   }
   m.silhouette_rms_px = pick.best->rms_px;
+  if (const double sy = rad2deg(pick.best->dilation_yaw_sigma_rad); sy > options.warn_dilation_yaw_sigma_deg)
+    m.warnings.push_back(fmt::format(
+        "the outline's width barely changes with yaw in these photos: were it {:.2f} px wider all round than the "
+        "model's (as blur and the shading of rounded edges make it), the yaw would turn by {:.1f}°, which the azimuth "
+        "σ includes; photograph the antenna over a wider arc or from nearer",
+        options.silhouette_options.outline_dilation_px, sy));
   m.method = fmt::format("model {}, points + outline in {} photos", model.name, pick.best->views_used);
   for (const auto& w : pick.best->warnings) m.warnings.push_back("outline: " + w);
   if (pick.flipped_by_outline)

@@ -158,6 +158,10 @@ struct NonContactOptions {
   double fail_fitness = 0.5;
   double fail_fitness_with_outline = 0.2;  // when the outline matched the photos
   double warn_fitness = 0.75;              // share of points near the model below this: warning
+  /// The outline's yaw σ owed to a dilation of the whole outline alone
+  /// (registration::SilhouetteResult::dilation_yaw_sigma_rad) above this: a warning to photograph
+  /// over a wider arc or from nearer (the azimuth target).
+  double warn_dilation_yaw_sigma_deg = 1.0;
   /// The outline refit with the points' long axis held (hold_axis_to_points) has fitted something
   /// else where it leaves fewer of the region's points near the model than this share of those
   /// the points' own pose does: it is not taken (2112-1, a thesis panel face-on before its mast:

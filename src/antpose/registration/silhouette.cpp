@@ -660,22 +660,27 @@ SilhouetteResult refine_by_silhouette(const model::Mesh& mesh_antenna, const Iso
     const double inflation = std::max(1.0, options.correlation_length_px / options.sample_spacing_px);
     // Sandwich H⁻¹ (Σ_white + Σ_bias) H⁻¹: white edge noise (inflated for the samples' overlap),
     // plus errors shared by all samples of a mesh edge: the model's shape tolerance (the same in
-    // every view) and an edge-localisation bias per view and edge (background, blur, shading).
+    // every view) and an edge-localisation bias per view and edge (background, blur, shading),
+    // plus that bias common to the whole outline (a dilation, see the header).
     // The prior counts once as information (in H) and once as its own noise (in M).
     Mat6 M = sigma2 * inflation * n.H;
     if (prior)
       M.topLeftCorner<3, 3>() += (prior_weight * prior_weight - sigma2 * inflation * prior_weight) * prior->information;
     std::vector<Vec6> shape(m.edges.size(), Vec6::Zero()), bias(m.edges.size(), Vec6::Zero());
+    Vec6 dilation = Vec6::Zero();
     for (const auto& view : g.per_view)
       for (const auto& s : view) {
         const double w = n.weight(s.r);
         if (w <= 0) continue;
         shape[s.edge] += w * s.px_per_m * options.shape_tolerance_m * s.J.transpose();
         bias[s.edge] += w * options.edge_bias_px * s.J.transpose();
+        dilation += w * options.outline_dilation_px * s.J.transpose();
       }
     for (std::size_t e = 0; e < m.edges.size(); ++e)
       M += shape[e] * shape[e].transpose() + bias[e] * bias[e].transpose();
+    M += dilation * dilation.transpose();
     result.covariance = Hinv * M * Hinv;
+    result.dilation_yaw_sigma_rad = std::abs((Hinv * dilation).head<3>().dot(pose.R.col(2)));
   }
 
   // The iteration limit is judged last: alone, it leaves a descent a search may continue.

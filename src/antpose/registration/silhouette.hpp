@@ -40,7 +40,11 @@
 // which do not average out along it nor over the views: b_g = Σ_{i∈g} w_i J_iᵀ s_i over all views,
 // once with s_i = f · shape_tolerance_m / depth (the model's shape error) and once with
 // s_i = edge_bias_px (edge localisation biased by the shading of rounded edges near the outline and
-// by the background, both similar from view to view under one sun).
+// by the background, both similar from view to view under one sun). One more such b, over every
+// sample of every edge with s_i = outline_dilation_px, is the whole outline found wider (or
+// narrower) than the model's by the same amount everywhere: blur and the shading of the rounded
+// long edges do that in every photo alike, and for a narrow panel seen face-on only the yaw can
+// widen the outline, so a dilation of a fraction of a pixel reads as degrees of yaw (5910-2).
 #pragma once
 
 #include <array>
@@ -100,6 +104,7 @@ struct SilhouetteOptions {
   double correlation_length_px = 12;  // covariance inflation (see the file comment)
   double shape_tolerance_m = 0.001;   // model vs real panel, per mesh edge (covariance)
   double edge_bias_px = 0.1;          // edge-localisation bias per mesh edge, all views (covariance)
+  double outline_dilation_px = 0.10;  // the same, common to the whole outline in all views (covariance)
   // The model's box (width, depth, height along x_a, y_a, z_a, centred at the antenna frame's
   // origin); outline points more than box_tolerance_m outside it (brackets and mounting parts on
   // the back plate) are not measured: in a photo their outline runs into the arms and clamps that
@@ -134,6 +139,10 @@ struct SilhouetteResult {
   Iso3 T_board_antenna = Iso3::Identity();  // refined; p_board = T p_antenna
   /// (rotation vector δ in the board frame, R_true = exp(δ) R_est; translation, m).
   Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();
+  /// The σ of the turn about the model's z axis (a panel's long axis) that covariance owes to
+  /// SilhouetteOptions::outline_dilation_px alone (rad): large where the outline's width barely
+  /// changes with yaw (a narrow panel seen face-on), which wider-spread views cure.
+  double dilation_yaw_sigma_rad = 0;
   double rms_px = 0;  // weighted edge-distance RMS of the samples used, full resolution
   double inlier_fraction = 0;
   double score = 1;  // mean truncated cost of the outline, 0 (perfect) .. 1 (no edge found)
