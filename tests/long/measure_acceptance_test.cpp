@@ -223,7 +223,9 @@ TEST(MeasureAcceptance, SimulatedSitesThroughTheCommandLine) {
         EXPECT_LE(std::abs(tilt), 0.5) << "site " << seed << ", antenna " << i;
         // A thesis panel seen face-on from the ground over 9°: its outline's width barely changes
         // with yaw, and the answer says so (SilhouetteResult::dilation_yaw_sigma_rad).
-        if (seed == 3312) EXPECT_NE(warnings.find("width barely changes with yaw"), std::string::npos) << warnings;
+        if (seed == 3312) {
+          EXPECT_NE(warnings.find("width barely changes with yaw"), std::string::npos) << warnings;
+        }
         if (!disturbance) {
           EXPECT_LE(std::abs(az), 2.0) << "site " << seed << ", antenna " << i;
         }

@@ -65,6 +65,9 @@ struct SceneOptions {
   int supersampling = 2;
   Vec3 antenna_centre = Vec3(1.0, -0.3, 1.2);  // world (= board frame), m
   double wall_z = 9.0;                         // the far wall's distance, m
+  /// Small textured cards facing the cameras (centre in the world, half-size, m): objects nearer
+  /// than the antenna that give features but too few points for an antenna.
+  std::vector<std::pair<Vec3, double>> cards;
 };
 
 struct Scene {
@@ -132,6 +135,15 @@ inline Scene make_scene(const SceneOptions& options) {
   wall.max_xy = Eigen::Vector2d(10, 1.5);
   wall.texture = sim::procedural_texture(options.seed + 2, 2.0, 256, 0.5, 0.12);
   patches.push_back(wall);
+  for (std::size_t i = 0; i < options.cards.size(); ++i) {
+    sim::TexturedPatch card;
+    card.name = "card";
+    card.p_world_patch = options.cards[i].first;
+    const double h = options.cards[i].second;
+    card.min_xy = Eigen::Vector2d(-h, -h), card.max_xy = Eigen::Vector2d(h, h);
+    card.texture = sim::procedural_texture(options.seed + 10 + i, 2 * h, 256, 0.5, 0.45);
+    patches.push_back(card);
+  }
 
   const sim::PhotoRenderer renderer(scene.K, options.supersampling);
   sim::Lighting light;

@@ -89,6 +89,9 @@ struct RegionOptions {
   /// The object is sought among points farther than this from the region's camera (along its
   /// axis): 0 takes the nearest; a previous result's depth_far_m takes the object behind it.
   double beyond_m = 0.0;
+  /// Where an object gives too few points, the next one beyond it is tried, up to this many
+  /// objects in all (reconstruct_region).
+  int max_objects = 3;
   /// Points inside this board-frame box (min, max corner) are not the object: the calibration
   /// board itself when the rectangle overlaps it (nearer, and far better textured, it would
   /// otherwise be taken for the object).
@@ -114,7 +117,8 @@ struct RegionReconstruction {
 /// image, the region is seen in fewer than 2 views, or fewer than options.min_points points
 /// remain (the message says which, e.g. "no texture or object in the region"). The object is the
 /// nearest one in the rectangle; where its surface gives too few points (the roof's edge reaching
-/// into the rectangle), the object beyond it, with a warning.
+/// into the rectangle, or false matches between an antenna's two equal brackets), the object
+/// beyond it, and so on up to options.max_objects, with a warning.
 RegionReconstruction reconstruct_region(const std::vector<PosedView>& views, const RefinedPoses& poses,
                                         std::size_t roi_view, const Roi& roi,
                                         const camera::CameraIntrinsics& intrinsics, const RegionOptions& options,

@@ -712,28 +712,37 @@ RegionReconstruction reconstruct_object(const std::vector<PosedView>& views, con
 // object nearer than the antenna may reach into it: on site 501 (a rooftop panel 6.6 m away) the
 // rectangle's end held the roof's edge 1.4–3.3 m away, whose 18 features made the nearest
 // cluster, and the dense stage found nothing there. Where the nearest object's surface gives too
-// few points, the next object beyond it is reconstructed instead, with a warning.
+// few points, the next object beyond it is reconstructed instead, with a warning, and so on:
+// on 6003-2 (a thesis panel 9.3 m away on a rooftop) the features made clusters at 2.0–2.6 m
+// (the board's tripod, 2.3 m away) and at 6.7–8.6 m, where the scene holds nothing (false
+// matches), before the panel at 8.4–10.2 m; no two dense pairs agreed on either.
 RegionReconstruction reconstruct_region(const std::vector<PosedView>& views, const RefinedPoses& poses,
                                         std::size_t roi_view, const Roi& roi,
                                         const camera::CameraIntrinsics& intrinsics, const RegionOptions& options,
                                         const Progress& progress) {
-  try {
-    return reconstruct_object(views, poses, roi_view, roi, intrinsics, options, progress);
-  } catch (const TooFewPoints& nearest) {
+  std::optional<TooFewPoints> nearest;
+  std::vector<std::string> passed;  // the depth ranges that gave too few points
+  RegionOptions here = options;
+  for (int k = 0; k < std::max(1, options.max_objects); ++k) {
     try {
-      RegionOptions beyond = options;
-      beyond.beyond_m = nearest.range.far;
-      auto out = reconstruct_object(views, poses, roi_view, roi, intrinsics, beyond, progress);
-      out.warnings.insert(out.warnings.begin(),
-                          fmt::format("the nearest object in the region of {}, {:.1f}–{:.1f} m from the camera, gave "
-                                      "too few points for an antenna (the roof's edge, a parapet?): the object beyond "
-                                      "it was reconstructed; check the model drawn over the photos",
-                                      views[roi_view].name, nearest.range.near, nearest.range.far));
+      auto out = reconstruct_object(views, poses, roi_view, roi, intrinsics, here, progress);
+      if (!passed.empty())
+        out.warnings.insert(out.warnings.begin(),
+                            fmt::format("the nearer object(s) in the region of {}, {} m from the camera, gave too few "
+                                        "points for an antenna (the roof's edge, a parapet, false matches?): the "
+                                        "object beyond was reconstructed; check the model drawn over the photos",
+                                        views[roi_view].name, fmt::join(passed, " and ")));
       return out;
+    } catch (const TooFewPoints& e) {
+      if (!nearest) nearest = e;
+      passed.push_back(fmt::format("{:.1f}–{:.1f}", e.range.near, e.range.far));
+      here.beyond_m = e.range.far;
     } catch (const MeasurementError&) {
-      throw MeasurementError(nearest.what());  // the nearest object's reason: nothing beyond it did better
+      if (!nearest) throw;
+      break;  // nothing beyond
     }
   }
+  throw MeasurementError(nearest->what());  // the nearest object's reason: nothing beyond it did better
 }
 
 }  // namespace antpose::reconstruction
