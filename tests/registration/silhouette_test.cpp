@@ -493,7 +493,7 @@ TEST(Silhouette, AKnownMastBehindANarrowPanelLeavesThePanelsOwnOutline) {
 
 // A dilation of the whole outline (blur and the shading of rounded edges widen it alike in every
 // photo) can only be told from a turn where the views see the panel's width change with yaw in
-// different ways: over 30° from 6 m (the rooftop) it turns the yaw by hundredths of a degree;
+// different ways: over 30° from 6 m (the rooftop) it turns the yaw by under a hundredth of a degree;
 // a narrow panel seen face-on from 26 m over 10° must widen by turning, so outline_dilation_px
 // turns it by degrees (5910-2: the outline found 0.13 px wider than the model's at the truth,
 // and the fit settled 3.5° away), and the yaw's σ holds that.
