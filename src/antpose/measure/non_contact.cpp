@@ -628,11 +628,18 @@ void decide_front_by_mount(AntennaMeasurement& m, SilhouettePick& pick, const mo
 // (the mast's and the clamps' edges beside it fit as well): beyond the gate the outline is refined
 // again with its axis held to the one kept (keep_axis: its tilt along the line of sight the
 // points', across it the outline's own), and only the yaw and position free. Returns the rotation
-// covariance (board frame) to use, or nothing when the outline's own stands.
-std::optional<Mat3> hold_axis_to_points(AntennaMeasurement& m, Iso3& T_antenna_board, const Mat3& cov_outline,
-                                        const model::AntennaModel& model, const Vec3& axis_points, const Scene& scene,
-                                        const std::function<bool(const Iso3&)>& fits_points,
-                                        const NonContactOptions& options) {
+// covariance (board frame) to use and the refit's dilation σ, or nothing when the outline's own
+// stands.
+struct HeldToPoints {
+  Mat3 cov_board;
+  double dilation_yaw_sigma_rad;  // registration::SilhouetteResult's, of the fit kept
+};
+
+std::optional<HeldToPoints> hold_axis_to_points(AntennaMeasurement& m, Iso3& T_antenna_board, const Mat3& cov_outline,
+                                                double dilation_yaw_sigma_rad, const model::AntennaModel& model,
+                                                const Vec3& axis_points, const Scene& scene,
+                                                const std::function<bool(const Iso3&)>& fits_points,
+                                                const NonContactOptions& options) {
   const Mat3 R_outline = T_antenna_board.rotation().transpose();
   const KeptAxis kept =
       keep_axis(R_outline.col(2), axis_points, mean_line_of_sight(scene, T_antenna_board.inverse().translation()),
@@ -664,13 +671,13 @@ std::optional<Mat3> hold_axis_to_points(AntennaMeasurement& m, Iso3& T_antenna_b
                          "downtilt and roll σ cover both");
     T_antenna_board = r.T_board_antenna.inverse();
     const Mat3 across = kept.sideways.dot(cov_outline * kept.sideways) * kept.sideways * kept.sideways.transpose();
-    return Mat3(r.covariance.topLeftCorner<3, 3>() + along + across);
+    return HeldToPoints{r.covariance.topLeftCorner<3, 3>() + along + across, r.dilation_yaw_sigma_rad};
   }
   m.warnings.push_back(disagreement +
                        ", and the outline does not fit with the points' tilt: that tilt is kept, and the downtilt "
                        "and roll σ cover both");
   T_antenna_board = start.inverse();
-  return Mat3(cov_outline + along);
+  return HeldToPoints{cov_outline + along, dilation_yaw_sigma_rad};
 }
 
 // The outline's score along the yaw about a held long axis, the position refit at each yaw
@@ -795,6 +802,26 @@ MastScene with_mast(const PointCloud& cloud_board, const Scene& scene, const Iso
     }
   }
   return {std::move(out), std::move(mast)};
+}
+
+// The region's points off the mast: those horizontally farther than options.off_mast_m from the
+// surface of the vertical cylinder most of them lie on (reconstruction::mast_from_points); none
+// where no cylinder holds them or too few points are left. Among clamps and arms, or scattered in
+// depth, that cylinder's band is wider than the mast (on 6109-2, 0.62 m for a 0.057 m mast), and
+// it takes them too. It is not confirmed by its outline (reconstruction::fit_mast): there, below
+// the panel, the board on its tripod hid the mast in every photo.
+std::optional<PointCloud> off_the_mast(const PointCloud& cloud_board, const Scene& scene,
+                                       const NonContactOptions& options) {
+  const auto mast = reconstruction::mast_from_points(cloud_board, scene.up_board, options.mast_options);
+  if (!mast) return std::nullopt;
+  const Vec3 up = mast->up_board.normalized();
+  PointCloud off;
+  for (const Vec3& p : cloud_board.points) {
+    const Vec3 d = p - mast->axis_point_board;
+    if (std::abs((d - d.dot(up) * up).norm() - mast->radius_m) > options.off_mast_m) off.points.push_back(p);
+  }
+  if (off.size() < options.region.min_points) return std::nullopt;
+  return off;
 }
 
 // The other antennas already registered, as known objects in the photos of antenna k: each one's
@@ -1010,8 +1037,12 @@ OutlineSearch search_outline(const PointCloud& cloud_board, const model::Antenna
   // each placed first (SearchStarts::placed): on 4502-1 the points' axis lay 0.2° from the
   // truth's where upright was 6.9° off, and their box 7 cm to the side of the panel. Last, the
   // fine placed search (options.fine_yaw_step_deg): where the points are far off in both place
-  // and axis, a panel seen side-on has a basin too narrow for the starts 25° apart. All run only
-  // where all else failed, so no answer found before them changes.
+  // and axis, a panel seen side-on has a basin too narrow for the starts 25° apart. Then the
+  // points off the mast (off_the_mast) registered again, the free search from their pose and its
+  // other_positions: on 6109-2 (a 2 m panel 4.3 m away on a rooftop, refused) the mast, clamps and
+  // arms held two thirds of the points, and the box on them sat 0.29 m to the side of the panel,
+  // where even a start at the true rotation placed itself on the mast. All run only where all else
+  // failed, so no answer found before them changes.
   const auto search_again = [&](const Iso3& T_board_start, const SearchStarts& starts) {
     auto again = silhouette_search(model, T_board_start, site, options, starts);
     again.tried += pick.tried;
@@ -1033,8 +1064,16 @@ OutlineSearch search_outline(const PointCloud& cloud_board, const model::Antenna
       auto fine = SearchStarts::placed_on(std::nullopt);
       for (double yaw = -90.0; yaw < 90.0 - 1e-9; yaw += options.fine_yaw_step_deg) fine.yaws_deg.push_back(yaw);
       fine.sight_turns_deg = options.fine_sight_turns_deg;
-      search_again(T_antenna_board.inverse(), fine);
+      found = search_again(T_antenna_board.inverse(), fine);
     }
+    if (!found && options.off_mast_m > 0.0)
+      if (const auto off = off_the_mast(cloud_board, site, options)) {
+        const auto again = register_points(*off, model, site, options);
+        found = search_again(again.start.fit.T_target_source.inverse(), {});
+        for (const Iso3& T :
+             other_positions(again.start, model.size_m, options.other_position_m, options.other_positions))
+          if (!found) found = search_again(T.inverse(), {});
+      }
   }
   return s;
 }
@@ -1134,12 +1173,7 @@ OutlineFit fit_outline(AntennaMeasurement& m, const model::AntennaModel& model, 
             : fmt::format("to within its profile's {:.0f}° step", options.held_yaw_step_deg)));
   }
   m.silhouette_rms_px = pick.best->rms_px;
-  if (const double sy = rad2deg(pick.best->dilation_yaw_sigma_rad); sy > options.warn_dilation_yaw_sigma_deg)
-    m.warnings.push_back(fmt::format(
-        "the outline's width barely changes with yaw in these photos: were it {:.2f} px wider all round than the "
-        "model's (as blur and the shading of rounded edges make it), the yaw would turn by {:.1f}°, which the azimuth "
-        "σ includes; photograph the antenna over a wider arc or from nearer",
-        options.silhouette_options.outline_dilation_px, sy));
+  double dilation_yaw_sigma_rad = pick.best->dilation_yaw_sigma_rad;
   m.method = fmt::format("model {}, points + outline in {} photos", model.name, pick.best->views_used);
   for (const auto& w : pick.best->warnings) m.warnings.push_back("outline: " + w);
   if (pick.flipped_by_outline)
@@ -1153,10 +1187,16 @@ OutlineFit fit_outline(AntennaMeasurement& m, const model::AntennaModel& model, 
       return points_fit(m.region.cloud_board, points.model.tree, T, points.reach_m).fitness >=
              options.outline_points_fit_ratio * points.start.fit.fitness;
     };
-    if (const auto held =
-            hold_axis_to_points(m, fit.T_antenna_board, fit.cov_board, model, axis_points, scene, fits_points, options))
-      fit.cov_board = *held;
+    if (const auto held = hold_axis_to_points(m, fit.T_antenna_board, fit.cov_board, dilation_yaw_sigma_rad, model,
+                                              axis_points, scene, fits_points, options))
+      fit.cov_board = held->cov_board, dilation_yaw_sigma_rad = held->dilation_yaw_sigma_rad;
   }
+  if (const double sy = rad2deg(dilation_yaw_sigma_rad); sy > options.warn_dilation_yaw_sigma_deg)
+    m.warnings.push_back(fmt::format(
+        "the outline's width barely changes with yaw in these photos: were it {:.2f} px wider all round than the "
+        "model's (as blur and the shading of rounded edges make it), the yaw would turn by {:.1f}°, which the azimuth "
+        "σ includes; photograph the antenna over a wider arc or from nearer",
+        options.silhouette_options.outline_dilation_px, sy));
   return fit;
 }
 

@@ -98,6 +98,10 @@ struct NonContactOptions {
   /// starts missed even at the true yaw. Answered, it is 0.02° off in azimuth, 0.06° in downtilt.
   double fine_yaw_step_deg = 10.0;
   std::vector<double> fine_sight_turns_deg = {-6.0, 0.0, 6.0};
+  /// Last of all, the region's points this near the mast's surface (its clamps too) are set
+  /// aside, the model registered to the rest and the free search repeated from there and from
+  /// its other_positions; 0: never. The sim's clamps reach 0.045 m beyond the mast.
+  double off_mast_m = 0.06;
   double silhouette_rival_margin = 0.02;  // a converged start within this score is a rival
   /// ... or, at another yaw, within this share of the winner's score, if more. Poses 67–79° apart
   /// scored 0.288 and 0.343 (2912-2, the worse one right) and 0.294 and 0.368 (2112-3, the better

@@ -170,6 +170,7 @@ std::optional<std::pair<double, double>> edge_pair(const std::vector<double>& pr
 
 // Stage 1's result: the points on the mast, a point of its seen surface, their height range.
 struct SeenPoints {
+  Circle circle;               // horizontal
   Vec2 anchor = Vec2::Zero();  // horizontal mean of the points on it
   double low = 0.0, high = 0.0;
   std::size_t count = 0;
@@ -181,6 +182,7 @@ std::optional<SeenPoints> points_on_mast(const PointCloud& points_board, const H
   const auto circle = ransac_circle(flat, o);
   if (!circle) return std::nullopt;
   SeenPoints seen;
+  seen.circle = *circle;
   seen.low = 1e300, seen.high = -1e300;
   for (std::size_t i = 0; i < flat.size(); ++i)
     if (circle->distance(flat[i]) <= o.point_tolerance_m) {
@@ -364,6 +366,20 @@ std::optional<Mast> fit_mast(const PointCloud& points_board, const Vec3& up_boar
   if (mast.views < o.min_views || static_cast<double>(inliers) < o.min_edge_fraction * static_cast<double>(sampled) ||
       mast.edge_rms_px > o.max_rms_px)
     return std::nullopt;
+  return mast;
+}
+
+std::optional<Mast> mast_from_points(const PointCloud& points_board, const Vec3& up_board, const MastOptions& o) {
+  const Horizontal h(up_board);
+  const auto seen = points_on_mast(points_board, h, o);
+  if (!seen) return std::nullopt;
+  Mast mast;
+  const double z_mid = 0.5 * (seen->low + seen->high);
+  mast.axis_point_board = h.point(seen->circle.centre, z_mid);
+  mast.up_board = h.up;
+  mast.radius_m = seen->circle.radius;
+  mast.low_m = seen->low - z_mid, mast.high_m = seen->high - z_mid;
+  mast.points = seen->count;
   return mast;
 }
 

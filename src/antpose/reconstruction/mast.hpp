@@ -75,6 +75,11 @@ std::optional<Mast> fit_mast(const PointCloud& points_board, const Vec3& up_boar
                              const camera::CameraIntrinsics& intrinsics, double outline_low_m, double outline_high_m,
                              const MastOptions& options);
 
+/// Stage 1 alone: the vertical cylinder that most of `points_board` lie on, over their height
+/// range, unconfirmed by the photos (views 0); nullopt where none holds options.min_points over
+/// options.min_height_m. From afar its radius is rough (the points scatter in depth).
+std::optional<Mast> mast_from_points(const PointCloud& points_board, const Vec3& up_board, const MastOptions& options);
+
 /// The mast's two outline lines in a photo (px, as taken), each a polyline from its low end to
 /// its high end in `segments` pieces; both empty when the camera is inside the cylinder or a
 /// point lies behind it.

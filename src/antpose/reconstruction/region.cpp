@@ -720,7 +720,7 @@ RegionReconstruction reconstruct_region(const std::vector<PosedView>& views, con
                                         std::size_t roi_view, const Roi& roi,
                                         const camera::CameraIntrinsics& intrinsics, const RegionOptions& options,
                                         const Progress& progress) {
-  std::optional<TooFewPoints> nearest;
+  std::string nearest;              // why the nearest object gave too few points
   std::vector<std::string> passed;  // the depth ranges that gave too few points
   RegionOptions here = options;
   for (int k = 0; k < std::max(1, options.max_objects); ++k) {
@@ -734,15 +734,15 @@ RegionReconstruction reconstruct_region(const std::vector<PosedView>& views, con
                                         views[roi_view].name, fmt::join(passed, " and ")));
       return out;
     } catch (const TooFewPoints& e) {
-      if (!nearest) nearest = e;
+      if (nearest.empty()) nearest = e.what();
       passed.push_back(fmt::format("{:.1f}–{:.1f}", e.range.near, e.range.far));
       here.beyond_m = e.range.far;
     } catch (const MeasurementError&) {
-      if (!nearest) throw;
+      if (nearest.empty()) throw;
       break;  // nothing beyond
     }
   }
-  throw MeasurementError(nearest->what());  // the nearest object's reason: nothing beyond it did better
+  throw MeasurementError(nearest);  // the nearest object's reason: nothing beyond it did better
 }
 
 }  // namespace antpose::reconstruction
