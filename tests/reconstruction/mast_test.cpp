@@ -155,15 +155,13 @@ TEST(Mast, FromPointsAloneIsTheCylinderTheyLieOn) {
   EXPECT_GT(mast->points, 2000u);  // of the 85 % on it
   // From 20 m the arc's 2 cm scatter leaves the radius rough, but its band holds the points on
   // the mast.
-  const auto from_surface = [&](const Vec3& p, const Vec3& axis_point, double radius) {
-    const Vec3 d = p - axis_point;
-    return std::abs((d - d.dot(up) * up).norm() - radius);
-  };
+  Mast truth = *mast;
+  truth.up_board = up, truth.axis_point_board = axis_board, truth.radius_m = empty.radius;
   std::size_t on_mast = 0, in_band = 0;
   for (const Vec3& p : points.points)
-    if (from_surface(p, axis_board, empty.radius) < 0.06) {
+    if (distance_from_surface(truth, p) < 0.06) {
       ++on_mast;
-      in_band += from_surface(p, mast->axis_point_board, mast->radius_m) <= MastOptions{}.point_tolerance_m;
+      in_band += distance_from_surface(*mast, p) <= MastOptions{}.point_tolerance_m;
     }
   std::printf("%zu of the %zu points on the mast in its band\n", in_band, on_mast);
   EXPECT_GT(in_band, 0.85 * static_cast<double>(on_mast));  // the 2 cm scatter leaves ~11 % beyond 4 cm

@@ -632,13 +632,12 @@ void decide_front_by_mount(AntennaMeasurement& m, SilhouettePick& pick, const mo
 // stands.
 struct HeldToPoints {
   Mat3 cov_board;
-  double dilation_yaw_sigma_rad;  // registration::SilhouetteResult's, of the fit kept
+  std::optional<double> dilation_yaw_sigma_rad;  // the refit's (SilhouetteResult's), where it is kept
 };
 
 std::optional<HeldToPoints> hold_axis_to_points(AntennaMeasurement& m, Iso3& T_antenna_board, const Mat3& cov_outline,
-                                                double dilation_yaw_sigma_rad, const model::AntennaModel& model,
-                                                const Vec3& axis_points, const Scene& scene,
-                                                const std::function<bool(const Iso3&)>& fits_points,
+                                                const model::AntennaModel& model, const Vec3& axis_points,
+                                                const Scene& scene, const std::function<bool(const Iso3&)>& fits_points,
                                                 const NonContactOptions& options) {
   const Mat3 R_outline = T_antenna_board.rotation().transpose();
   const KeptAxis kept =
@@ -677,7 +676,7 @@ std::optional<HeldToPoints> hold_axis_to_points(AntennaMeasurement& m, Iso3& T_a
                        ", and the outline does not fit with the points' tilt: that tilt is kept, and the downtilt "
                        "and roll σ cover both");
   T_antenna_board = start.inverse();
-  return HeldToPoints{cov_outline + along, dilation_yaw_sigma_rad};
+  return HeldToPoints{cov_outline + along, std::nullopt};
 }
 
 // The outline's score along the yaw about a held long axis, the position refit at each yaw
@@ -814,12 +813,9 @@ std::optional<PointCloud> off_the_mast(const PointCloud& cloud_board, const Scen
                                        const NonContactOptions& options) {
   const auto mast = reconstruction::mast_from_points(cloud_board, scene.up_board, options.mast_options);
   if (!mast) return std::nullopt;
-  const Vec3 up = mast->up_board.normalized();
   PointCloud off;
-  for (const Vec3& p : cloud_board.points) {
-    const Vec3 d = p - mast->axis_point_board;
-    if (std::abs((d - d.dot(up) * up).norm() - mast->radius_m) > options.off_mast_m) off.points.push_back(p);
-  }
+  for (const Vec3& p : cloud_board.points)
+    if (reconstruction::distance_from_surface(*mast, p) > options.off_mast_m) off.points.push_back(p);
   if (off.size() < options.region.min_points) return std::nullopt;
   return off;
 }
@@ -936,16 +932,25 @@ struct PointsRegistration {
   double reach_m = 0.0;                      // the fine ICP's correspondence distance
 };
 
-PointsRegistration register_points(const PointCloud& cloud_board, const model::AntennaModel& model, const Scene& site,
-                                   const NonContactOptions& options) {
-  PointCloud model_cloud = model::sample_surface(model.mesh_antenna, options.model_spacing_m, options.seed);
-  auto model_prepared = registration::prepare(model_cloud, options.registration.fine);
+// The model's prepared samples registered to `cloud_board` from the global start: the prepared
+// cloud and the start's fit (T_antenna_board).
+std::pair<registration::PreparedCloud, registration::GlobalStartResult> start_on(
+    const PointCloud& cloud_board, const registration::PreparedCloud& model_prepared, const Scene& site,
+    const NonContactOptions& options) {
   auto gopts = options.registration;
   gopts.viewpoints_scene = site.viewpoints;
   auto cloud = registration::prepare(cloud_board, gopts.fine);
   auto start = registration::global_align(cloud, model_prepared, site.up_board, gopts);
+  return {std::move(cloud), std::move(start)};
+}
+
+PointsRegistration register_points(const PointCloud& cloud_board, const model::AntennaModel& model, const Scene& site,
+                                   const NonContactOptions& options) {
+  PointCloud model_cloud = model::sample_surface(model.mesh_antenna, options.model_spacing_m, options.seed);
+  auto model_prepared = registration::prepare(model_cloud, options.registration.fine);
+  auto [cloud, start] = start_on(cloud_board, model_prepared, site, options);
   return {std::move(model_cloud), std::move(model_prepared), std::move(cloud), std::move(start),
-          gopts.fine.max_correspondence_distance_m};
+          options.registration.fine.max_correspondence_distance_m};
 }
 
 // The lower score of the descents from T_board_antenna in `scene` with both edge searches (as
@@ -1068,11 +1073,10 @@ OutlineSearch search_outline(const PointCloud& cloud_board, const model::Antenna
     }
     if (!found && options.off_mast_m > 0.0)
       if (const auto off = off_the_mast(cloud_board, site, options)) {
-        const auto again = register_points(*off, model, site, options);
-        found = search_again(again.start.fit.T_target_source.inverse(), {});
-        for (const Iso3& T :
-             other_positions(again.start, model.size_m, options.other_position_m, options.other_positions))
-          if (!found) found = search_again(T.inverse(), {});
+        const auto again = start_on(*off, points.model, site, options).second;
+        if (!(found = search_again(again.fit.T_target_source.inverse(), {})))
+          for (const Iso3& T : other_positions(again, model.size_m, options.other_position_m, options.other_positions))
+            if ((found = search_again(T.inverse(), {}))) break;
       }
   }
   return s;
@@ -1187,9 +1191,11 @@ OutlineFit fit_outline(AntennaMeasurement& m, const model::AntennaModel& model, 
       return points_fit(m.region.cloud_board, points.model.tree, T, points.reach_m).fitness >=
              options.outline_points_fit_ratio * points.start.fit.fitness;
     };
-    if (const auto held = hold_axis_to_points(m, fit.T_antenna_board, fit.cov_board, dilation_yaw_sigma_rad, model,
-                                              axis_points, scene, fits_points, options))
-      fit.cov_board = held->cov_board, dilation_yaw_sigma_rad = held->dilation_yaw_sigma_rad;
+    if (const auto held = hold_axis_to_points(m, fit.T_antenna_board, fit.cov_board, model, axis_points, scene,
+                                              fits_points, options)) {
+      fit.cov_board = held->cov_board;
+      dilation_yaw_sigma_rad = held->dilation_yaw_sigma_rad.value_or(dilation_yaw_sigma_rad);
+    }
   }
   if (const double sy = rad2deg(dilation_yaw_sigma_rad); sy > options.warn_dilation_yaw_sigma_deg)
     m.warnings.push_back(fmt::format(

@@ -195,6 +195,20 @@ std::optional<SeenPoints> points_on_mast(const PointCloud& points_board, const H
   return seen;
 }
 
+// The mast with its axis through `centre` (horizontal), from height z_low to z_high, placed at the
+// middle of the heights its points span; without the photos' confirmation.
+Mast cylinder(const Horizontal& h, const SeenPoints& seen, const Vec2& centre, double radius, double z_low,
+              double z_high) {
+  Mast mast;
+  const double z_mid = 0.5 * (seen.low + seen.high);
+  mast.axis_point_board = h.point(centre, z_mid);
+  mast.up_board = h.up;
+  mast.radius_m = radius;
+  mast.low_m = z_low - z_mid, mast.high_m = z_high - z_mid;
+  mast.points = seen.count;
+  return mast;
+}
+
 // Stage 2a in one photo: gradients around the line through the anchor over the outline's
 // stretch, and the pair of opposite edges across the mast (edge_pair). Adds the edges' tangent
 // rays at three heights to `found` and returns the photo's estimate of the axis' place: the ray
@@ -352,14 +366,8 @@ std::optional<Mast> fit_mast(const PointCloud& points_board, const Vec3& up_boar
     if (std::abs(r) > 2.0 * o.loss_px) continue;
     ss += r * r, ++inliers, ++per_view[t.view];
   }
-  Mast mast;
-  const double z_mid = 0.5 * (seen->low + seen->high);
-  mast.axis_point_board = h.point(Vec2(p[0], p[1]), z_mid);
-  mast.up_board = h.up;
-  mast.radius_m = p[2];
-  mast.low_m = std::min(z_low, seen->low - o.extend_m) - z_mid;
-  mast.high_m = std::max(z_high, seen->high + o.extend_m) - z_mid;
-  mast.points = seen->count;
+  Mast mast = cylinder(h, *seen, Vec2(p[0], p[1]), p[2], std::min(z_low, seen->low - o.extend_m),
+                       std::max(z_high, seen->high + o.extend_m));
   mast.views = static_cast<std::size_t>(std::count_if(per_view.begin(), per_view.end(), [](auto n) { return n >= 5; }));
   mast.edge_samples = inliers;
   mast.edge_rms_px = inliers ? std::sqrt(ss / static_cast<double>(inliers)) : 0.0;
@@ -373,14 +381,7 @@ std::optional<Mast> mast_from_points(const PointCloud& points_board, const Vec3&
   const Horizontal h(up_board);
   const auto seen = points_on_mast(points_board, h, o);
   if (!seen) return std::nullopt;
-  Mast mast;
-  const double z_mid = 0.5 * (seen->low + seen->high);
-  mast.axis_point_board = h.point(seen->circle.centre, z_mid);
-  mast.up_board = h.up;
-  mast.radius_m = seen->circle.radius;
-  mast.low_m = seen->low - z_mid, mast.high_m = seen->high - z_mid;
-  mast.points = seen->count;
-  return mast;
+  return cylinder(h, *seen, seen->circle.centre, seen->circle.radius, seen->low, seen->high);
 }
 
 std::array<std::vector<cv::Point2f>, 2> mast_outline(const Mast& mast, const camera::CameraIntrinsics& K,
@@ -400,6 +401,11 @@ std::array<std::vector<cv::Point2f>, 2> mast_outline(const Mast& mast, const cam
       lines[side].emplace_back(static_cast<float>(uv->x()), static_cast<float>(uv->y()));
     }
   return lines;
+}
+
+double distance_from_surface(const Mast& mast, const Vec3& p_board) {
+  const Horizontal h(mast.up_board);
+  return std::abs((h.of(p_board) - h.of(mast.axis_point_board)).norm() - mast.radius_m);
 }
 
 bool mast_in_front(const Mast& mast, const Vec3& camera_centre_board, const Vec3& p_board) {

@@ -87,6 +87,9 @@ std::array<std::vector<cv::Point2f>, 2> mast_outline(const Mast& mast, const cam
                                                      const Mat3& R_camera_board, const Vec3& t_camera_board,
                                                      int segments = 16);
 
+/// The horizontal distance of `p_board` from the mast's surface (m, ≥ 0; inside it too).
+double distance_from_surface(const Mast& mast, const Vec3& p_board);
+
 /// Whether the mast's axis lies nearer to the camera than `p_board` (horizontal distances): what
 /// lies behind it there is hidden by it.
 bool mast_in_front(const Mast& mast, const Vec3& camera_centre_board, const Vec3& p_board);
