@@ -2,7 +2,13 @@
 //   antpose bench static-orientation DIR...   static eCompass on the rest phases (BROAD metric)
 //   antpose bench orientation DIR...          every orientation estimator, BROAD metric, throughput
 //   antpose bench orientation-grid DIR...     Madgwick beta × zeta sweep (thesis §4.6), SVG heat maps
+//   antpose bench registration [SHARED]      antpose's ICP against PCL's and Open3D's (docs/benchmarks.md)
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <map>
 #include <string>
@@ -53,9 +59,10 @@ void run_static_bench(const StaticBenchArgs& args) {
   options.window_s = args.window_s;
   std::vector<orientation::RestBenchmarkTrial> trials;
   Diagnostics diagnostics;
-  fmt::print("static orientation (TRIAD eCompass, {:.1f} s windows) on the first {:.0f} s of rest; BROAD error "
-             "metric, RMSE in degrees\n",
-             options.window_s, options.rest_s);
+  fmt::print(
+      "static orientation (TRIAD eCompass, {:.1f} s windows) on the first {:.0f} s of rest; BROAD error "
+      "metric, RMSE in degrees\n",
+      options.window_s, options.rest_s);
   fmt::print("{:<45} {:>8} {:>7} {:>9} {:>9} {:>12}\n", "trial", "samples", "rest_s", "total", "heading",
              "inclination");
   for (const auto& folder : capture_folders(args.dirs)) {
@@ -223,6 +230,38 @@ void run_orientation_grid(const OrientationBenchArgs& args) {
   print_warnings(diagnostics);
 }
 
+struct RegistrationBenchArgs {
+  std::string shared;  // empty: the build's ANTPOSE_SHARED_DIR
+  int repeats = 9;
+  std::string json;
+};
+
+// The comparison links PCL and Open3D, which antpose itself never does (benchmark-only
+// dependencies, not in CI), so it is a program of its own, built beside antpose where
+// scripts/install-bench-deps.sh installed them; this verb runs it in this process' place.
+[[noreturn]] void run_registration_bench(const RegistrationBenchArgs& args) {
+  if (!args.shared.empty() && !fs::exists(fs::path(args.shared) / "data/pointclouds/pcl/bun0.ply"))
+    throw InputError(args.shared, "no data/pointclouds/pcl/bun0.ply (expected the shared data folder)");
+#ifdef ANTPOSE_BENCH_REGISTRATION
+  const std::string program = ANTPOSE_BENCH_REGISTRATION;
+  if (!fs::exists(program))
+    throw Error(fmt::format("{} is not built yet: cmake --build build --target antpose_bench_registration", program));
+  std::vector<std::string> words{program, "--repeats", std::to_string(args.repeats)};
+  if (!args.json.empty()) words.insert(words.end(), {"--json", args.json});
+  if (!args.shared.empty()) words.push_back(args.shared);
+  std::vector<char*> argv;
+  for (auto& w : words) argv.push_back(w.data());
+  argv.push_back(nullptr);
+  std::fflush(nullptr);
+  execv(program.c_str(), argv.data());
+  throw Error(fmt::format("{}: cannot run it: {}", program, std::strerror(errno)));
+#else
+  throw Error(
+      "this build has no registration comparison: it needs PCL and Open3D (benchmark-only dependencies); "
+      "run scripts/install-bench-deps.sh, then scripts/setup.sh");
+#endif
+}
+
 }  // namespace
 
 void add_bench_command(CLI::App& app) {
@@ -239,12 +278,13 @@ void add_bench_command(CLI::App& app) {
   auto oargs = std::make_shared<OrientationBenchArgs>();
   auto* ob = bench->add_subcommand("orientation", "score every orientation estimator against captures with truth");
   ob->add_option("dirs", oargs->dirs, "capture folders, or folders of capture folders")->required();
-  ob->add_option("--methods", oargs->methods,
-                 fmt::format("comma-separated estimators (default: all: {})",
-                             fmt::join(orientation::estimator_names(), ",")));
+  ob->add_option(
+      "--methods", oargs->methods,
+      fmt::format("comma-separated estimators (default: all: {})", fmt::join(orientation::estimator_names(), ",")));
   ob->add_option("--json", oargs->json, "write the per-trial and mean results as JSON");
-  ob->add_option("--wmm", oargs->wmm, "extra WMM coefficient files for the declination (repeatable; with the built-in "
-                                      "WMM2025, the model valid for the capture date is used, else the nearest epoch)");
+  ob->add_option("--wmm", oargs->wmm,
+                 "extra WMM coefficient files for the declination (repeatable; with the built-in "
+                 "WMM2025, the model valid for the capture date is used, else the nearest epoch)");
   ob->add_option("--skip-s", oargs->skip_s, "truth without a moving column: seconds left out at its start")
       ->capture_default_str();
   ob->callback([oargs] { run_orientation_bench(*oargs); });
@@ -259,6 +299,18 @@ void add_bench_command(CLI::App& app) {
       ->capture_default_str();
   og->add_option("--threads", gargs->threads, "worker threads (0: all cores)")->capture_default_str();
   og->callback([gargs] { run_orientation_grid(*gargs); });
+
+  auto rargs = std::make_shared<RegistrationBenchArgs>();
+  auto* rb = bench->add_subcommand(
+      "registration",
+      "antpose's point-to-point, point-to-plane and generalized ICP against PCL's and Open3D's on the "
+      "same clouds: time, error and time ratios (needs scripts/install-bench-deps.sh)");
+  rb->add_option("shared", rargs->shared, "the shared data folder (default: the build's ANTPOSE_SHARED_DIR)");
+  rb->add_option("--repeats", rargs->repeats, "runs per method; the median time is reported")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  rb->add_option("--json", rargs->json, "write the results as JSON");
+  rb->callback([rargs] { run_registration_bench(*rargs); });
 }
 
 }  // namespace antpose::cli

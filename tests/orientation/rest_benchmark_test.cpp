@@ -38,11 +38,16 @@ TEST(BroadErrors, ClosedForms) {
 // below are those figures with a small margin, so a regression fails.
 TEST(RestBenchmark, BroadRestPhases) {
   const auto root = test::shared_path("data/orientation/broad");
-  const std::vector<std::string> names = {
-      "02_undisturbed_slow_rotation_B", "05_undisturbed_slow_rotation_with_breaks_B", "07_undisturbed_fast_rotation_B",
-      "09_undisturbed_fast_rotation_with_breaks_B", "11_undisturbed_slow_translation_B",
-      "16_undisturbed_fast_translation_B", "25_disturbed_tapping_B", "27_disturbed_phone_vibration_B",
-      "30_disturbed_stationary_magnet_C", "33_disturbed_attached_magnet_2cm"};
+  const std::vector<std::string> names = {"02_undisturbed_slow_rotation_B",
+                                          "05_undisturbed_slow_rotation_with_breaks_B",
+                                          "07_undisturbed_fast_rotation_B",
+                                          "09_undisturbed_fast_rotation_with_breaks_B",
+                                          "11_undisturbed_slow_translation_B",
+                                          "16_undisturbed_fast_translation_B",
+                                          "25_disturbed_tapping_B",
+                                          "27_disturbed_phone_vibration_B",
+                                          "30_disturbed_stationary_magnet_C",
+                                          "33_disturbed_attached_magnet_2cm"};
   std::vector<RestBenchmarkTrial> trials;
   for (const auto& name : names) {
     Diagnostics diag;
@@ -104,6 +109,23 @@ TEST(BenchCli, StaticOrientationTable) {
   const auto bad = test::run_cli("bench static-orientation /nonexistent-folder");
   EXPECT_EQ(bad.status, 2);
   EXPECT_THAT(bad.err, HasSubstr("no such folder"));
+}
+
+// The comparison with PCL and Open3D runs where they were installed (bench/CMakeLists.txt), and
+// elsewhere says what it needs.
+TEST(BenchCli, RegistrationComparisonOrWhatItNeeds) {
+  const auto res = test::run_cli("bench registration --repeats 1 " + test::shared_path("").string());
+  if (res.status == 0) {
+    EXPECT_THAT(res.out, HasSubstr("time / antpose"));
+    EXPECT_THAT(res.out, HasSubstr("open3d"));
+  } else {
+    EXPECT_EQ(res.status, 1);
+    EXPECT_THAT(res.err, HasSubstr("needs PCL and Open3D")) << res.err;
+  }
+  const auto bad = test::run_cli("bench registration /nonexistent-folder");
+  EXPECT_EQ(bad.status, 2);
+  EXPECT_THAT(bad.err, HasSubstr("/nonexistent-folder: no data/pointclouds/pcl/bun0.ply"));
+  EXPECT_NE(test::run_cli("bench registration --repeats 0").status, 0);
 }
 
 }  // namespace
