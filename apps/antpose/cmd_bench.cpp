@@ -257,8 +257,9 @@ struct RegistrationBenchArgs {
   throw Error(fmt::format("{}: cannot run it: {}", program, std::strerror(errno)));
 #else
   throw Error(
-      "this build has no registration comparison: it needs PCL and Open3D (benchmark-only dependencies); "
-      "run scripts/install-bench-deps.sh, then scripts/setup.sh");
+      "this build has no registration comparison: it needs PCL and Open3D (benchmark-only dependencies: "
+      "scripts/install-bench-deps.sh) and the benchmarks built (ANTPOSE_BUILD_BENCH=ON, the default); then "
+      "run scripts/setup.sh");
 #endif
 }
 

@@ -1035,16 +1035,17 @@ OutlineSearch search_outline(const PointCloud& cloud_board, const model::Antenna
     }
     s.with_the_mast.emplace(std::move(with_the_mast));
   }
-  // The points' winner may sit on the mast beside the panel (a rooftop pipe with more points than
-  // a sparse radome: 3201-1, 0.41 m off, no outline start within reach): the free search is
-  // repeated from the points' best poses started elsewhere, in turn, their outline judging them.
-  // Then the free search from the points' pose again, its starts on the points' long axis and
-  // each placed first (SearchStarts::placed): on 4502-1 the points' axis lay 0.2° from the
-  // truth's where upright was 6.9° off, and their box 7 cm to the side of the panel. Last, the
-  // fine placed search (options.fine_yaw_step_deg): where the points are far off in both place
-  // and axis, a panel seen side-on has a basin too narrow for the starts 25° apart. Then the
-  // points off the mast (off_the_mast) registered again, the free search from their pose and its
-  // other_positions: on 6109-2 (a 2 m panel 4.3 m away on a rooftop, refused) the mast, clamps and
+  // Where no start converged, the fallbacks run in turn until one finds a winner. (1) The points'
+  // winner may sit on the mast beside the panel (a rooftop pipe with more points than a sparse
+  // radome: 3201-1, 0.41 m off, no outline start within reach): the free search is repeated from
+  // the points' best poses started elsewhere, their outline judging them. (2) The free search
+  // from the points' pose again, its starts on the points' long axis and each placed first
+  // (SearchStarts::placed): on 4502-1 the points' axis lay 0.2° from the truth's where upright
+  // was 6.9° off, and their box 7 cm to the side of the panel. (3) The fine placed search
+  // (options.fine_yaw_step_deg): where the points are far off in both place and axis, a panel
+  // seen side-on has a basin too narrow for the starts 25° apart. (4) The points off the mast
+  // (off_the_mast) registered again, the free search from their pose and its other_positions:
+  // on 6109-2 (a 2 m panel 4.3 m away on a rooftop, refused) the mast, clamps and
   // arms held two thirds of the points, and the box on them sat 0.29 m to the side of the panel,
   // where even a start at the true rotation placed itself on the mast. All run only where all else
   // failed, so no answer found before them changes.
@@ -1060,25 +1061,30 @@ OutlineSearch search_outline(const PointCloud& cloud_board, const model::Antenna
     pick = std::move(again);
     return true;
   };
-  if (!pick.best && pass == OutlinePass::kFirst) {
-    bool found = false;
-    for (const Iso3& T : other_positions(points.start, model.size_m, options.other_position_m, options.other_positions))
-      if ((found = search_again(T.inverse(), {}))) break;
-    if (!found) found = search_again(T_antenna_board.inverse(), SearchStarts::placed_on(points_axis()));
-    if (!found && options.fine_yaw_step_deg > 0.0) {
-      auto fine = SearchStarts::placed_on(std::nullopt);
-      for (double yaw = -90.0; yaw < 90.0 - 1e-9; yaw += options.fine_yaw_step_deg) fine.yaws_deg.push_back(yaw);
-      fine.sight_turns_deg = options.fine_sight_turns_deg;
-      found = search_again(T_antenna_board.inverse(), fine);
-    }
-    if (!found && options.off_mast_m > 0.0)
-      if (const auto off = off_the_mast(cloud_board, site, options)) {
+  const auto search_from_other_positions = [&](const registration::GlobalStartResult& start) {
+    return std::ranges::any_of(other_positions(start, model.size_m, options.other_position_m, options.other_positions),
+                               [&](const Iso3& T) { return search_again(T.inverse(), {}); });
+  };
+  const std::function<bool()> fallbacks[] = {
+      [&] { return search_from_other_positions(points.start); },
+      [&] { return search_again(T_antenna_board.inverse(), SearchStarts::placed_on(points_axis())); },
+      [&] {
+        if (options.fine_yaw_step_deg <= 0.0) return false;
+        auto fine = SearchStarts::placed_on(std::nullopt);
+        for (double yaw = -90.0; yaw < 90.0 - 1e-9; yaw += options.fine_yaw_step_deg) fine.yaws_deg.push_back(yaw);
+        fine.sight_turns_deg = options.fine_sight_turns_deg;
+        return search_again(T_antenna_board.inverse(), fine);
+      },
+      [&] {
+        const auto off = options.off_mast_m > 0.0 ? off_the_mast(cloud_board, site, options) : std::nullopt;
+        if (!off) return false;
         const auto again = start_on(*off, points.model, site, options).second;
-        if (!(found = search_again(again.fit.T_target_source.inverse(), {})))
-          for (const Iso3& T : other_positions(again, model.size_m, options.other_position_m, options.other_positions))
-            if ((found = search_again(T.inverse(), {}))) break;
-      }
-  }
+        return search_again(again.fit.T_target_source.inverse(), {}) || search_from_other_positions(again);
+      },
+  };
+  if (!pick.best && pass == OutlinePass::kFirst)
+    for (const auto& fallback : fallbacks)
+      if (fallback()) break;
   return s;
 }
 
