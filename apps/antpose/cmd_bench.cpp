@@ -59,10 +59,9 @@ void run_static_bench(const StaticBenchArgs& args) {
   options.window_s = args.window_s;
   std::vector<orientation::RestBenchmarkTrial> trials;
   Diagnostics diagnostics;
-  fmt::print(
-      "static orientation (TRIAD eCompass, {:.1f} s windows) on the first {:.0f} s of rest; BROAD error "
-      "metric, RMSE in degrees\n",
-      options.window_s, options.rest_s);
+  fmt::print("static orientation (TRIAD eCompass, {:.1f} s windows) on the first {:.0f} s of rest; BROAD error "
+             "metric, RMSE in degrees\n",
+             options.window_s, options.rest_s);
   fmt::print("{:<45} {:>8} {:>7} {:>9} {:>9} {:>12}\n", "trial", "samples", "rest_s", "total", "heading",
              "inclination");
   for (const auto& folder : capture_folders(args.dirs)) {
@@ -279,13 +278,12 @@ void add_bench_command(CLI::App& app) {
   auto oargs = std::make_shared<OrientationBenchArgs>();
   auto* ob = bench->add_subcommand("orientation", "score every orientation estimator against captures with truth");
   ob->add_option("dirs", oargs->dirs, "capture folders, or folders of capture folders")->required();
-  ob->add_option(
-      "--methods", oargs->methods,
-      fmt::format("comma-separated estimators (default: all: {})", fmt::join(orientation::estimator_names(), ",")));
+  ob->add_option("--methods", oargs->methods,
+                 fmt::format("comma-separated estimators (default: all: {})",
+                             fmt::join(orientation::estimator_names(), ",")));
   ob->add_option("--json", oargs->json, "write the per-trial and mean results as JSON");
-  ob->add_option("--wmm", oargs->wmm,
-                 "extra WMM coefficient files for the declination (repeatable; with the built-in "
-                 "WMM2025, the model valid for the capture date is used, else the nearest epoch)");
+  ob->add_option("--wmm", oargs->wmm, "extra WMM coefficient files for the declination (repeatable; with the built-in "
+                                      "WMM2025, the model valid for the capture date is used, else the nearest epoch)");
   ob->add_option("--skip-s", oargs->skip_s, "truth without a moving column: seconds left out at its start")
       ->capture_default_str();
   ob->callback([oargs] { run_orientation_bench(*oargs); });

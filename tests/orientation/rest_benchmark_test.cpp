@@ -38,16 +38,11 @@ TEST(BroadErrors, ClosedForms) {
 // below are those figures with a small margin, so a regression fails.
 TEST(RestBenchmark, BroadRestPhases) {
   const auto root = test::shared_path("data/orientation/broad");
-  const std::vector<std::string> names = {"02_undisturbed_slow_rotation_B",
-                                          "05_undisturbed_slow_rotation_with_breaks_B",
-                                          "07_undisturbed_fast_rotation_B",
-                                          "09_undisturbed_fast_rotation_with_breaks_B",
-                                          "11_undisturbed_slow_translation_B",
-                                          "16_undisturbed_fast_translation_B",
-                                          "25_disturbed_tapping_B",
-                                          "27_disturbed_phone_vibration_B",
-                                          "30_disturbed_stationary_magnet_C",
-                                          "33_disturbed_attached_magnet_2cm"};
+  const std::vector<std::string> names = {
+      "02_undisturbed_slow_rotation_B", "05_undisturbed_slow_rotation_with_breaks_B", "07_undisturbed_fast_rotation_B",
+      "09_undisturbed_fast_rotation_with_breaks_B", "11_undisturbed_slow_translation_B",
+      "16_undisturbed_fast_translation_B", "25_disturbed_tapping_B", "27_disturbed_phone_vibration_B",
+      "30_disturbed_stationary_magnet_C", "33_disturbed_attached_magnet_2cm"};
   std::vector<RestBenchmarkTrial> trials;
   for (const auto& name : names) {
     Diagnostics diag;

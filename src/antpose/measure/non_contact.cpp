@@ -1061,9 +1061,11 @@ OutlineSearch search_outline(const PointCloud& cloud_board, const model::Antenna
     pick = std::move(again);
     return true;
   };
+  if (pick.best || pass != OutlinePass::kFirst) return s;
   const auto search_from_other_positions = [&](const registration::GlobalStartResult& start) {
-    return std::ranges::any_of(other_positions(start, model.size_m, options.other_position_m, options.other_positions),
-                               [&](const Iso3& T) { return search_again(T.inverse(), {}); });
+    for (const Iso3& T : other_positions(start, model.size_m, options.other_position_m, options.other_positions))
+      if (search_again(T.inverse(), {})) return true;
+    return false;
   };
   const std::function<bool()> fallbacks[] = {
       [&] { return search_from_other_positions(points.start); },
@@ -1082,9 +1084,8 @@ OutlineSearch search_outline(const PointCloud& cloud_board, const model::Antenna
         return search_again(again.fit.T_target_source.inverse(), {}) || search_from_other_positions(again);
       },
   };
-  if (!pick.best && pass == OutlinePass::kFirst)
-    for (const auto& fallback : fallbacks)
-      if (fallback()) break;
+  for (const auto& fallback : fallbacks)
+    if (fallback()) break;
   return s;
 }
 
