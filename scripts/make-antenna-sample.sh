@@ -9,7 +9,7 @@ A=${1:-./build/apps/antpose/antpose}
 W=$(mktemp -d)
 trap 'rm -rf "$W"' EXIT
 scripts/calibrate-simulated-phone.sh 21 "$W/phone.yaml" "$A"
-$A simulate capture -o "$W/antenna" --scenario antenna --seed 31 --device-seed 21 --setting rooftop --antennas 1 \
+$A simulate capture -o "$W/antenna" --scenario antenna --distribution classic --seed 31 --device-seed 21 --setting rooftop --antennas 1 \
   --photos 8 --jpeg-quality 85 --width 4000 --height 3000 --supersampling 2
 rm -rf examples/antenna-sample
 cp -r "$W/antenna" examples/antenna-sample

@@ -34,15 +34,15 @@ struct MeasureArgs {
 
 // A built-in panel name, or a mesh file with (optionally) its box file.
 model::AntennaModel load_model(const std::string& name, const std::string& box, const MeasureArgs& a) {
-  const auto names = model::builtin_panel_names();
-  if (!fs::exists(name) && std::find(names.begin(), names.end(), name) != names.end()) {
+  if (!fs::exists(name) && model::is_builtin_panel(name)) {
     if (!box.empty()) throw InputError(box, "--model-box: '" + name + "' is a built-in panel, which has its box");
     return model::builtin_panel(name);
   }
   if (!fs::exists(name)) {
     std::string list;
-    for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;
-    throw InputError(name, "--model: no such file, and not a built-in panel (" + list + ")");
+    for (const auto& n : model::builtin_panel_names()) list += (list.empty() ? "" : ", ") + n;
+    throw InputError(name, "--model: no such file, and not a built-in panel (" + list +
+                               ", or any datasheet box panel-<h>x<w>x<d> in mm)");
   }
   model::Units units = model::Units::kMetres;
   if (a.model_units == "mm")
@@ -132,7 +132,7 @@ int run_measure(const MeasureArgs& a) {
   }
 
   measure::NonContactOptions options;
-  options.orientation = a.orientation;
+  options.world.orientation = a.orientation;
   const auto start = std::chrono::steady_clock::now();
   options.progress = [&](const std::string& stage, int done, int total) {
     const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

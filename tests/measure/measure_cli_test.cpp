@@ -28,7 +28,8 @@ class MeasureCli : public ::testing::Test {
   static void SetUpTestSuite() {
     dir_ = new test::TempDir;
     const auto r = test::run_cli(fmt::format(
-        "simulate capture -o '{}' --scenario antenna --seed 3 --setting rooftop --photos 6 --width 960 --height 720",
+        "simulate capture -o '{}' --scenario antenna --distribution classic --seed 3 --setting rooftop --photos 6 "
+        "--width 960 --height 720",
         capture().string()));
     ASSERT_EQ(r.status, 0) << r.err;
     // A device profile from the simulator's truth.
@@ -78,29 +79,31 @@ TEST_F(MeasureCli, RoiOnTheSkyFailsThatAntennaWithItsReason) {
   const auto j = nlohmann::json::parse(io::read_text(json));
   ASSERT_EQ(j["antennas"].size(), 1u);
   EXPECT_TRUE(j["antennas"][0]["azimuth_magnetic_deg"].is_null());
-  EXPECT_THAT(j["antennas"][0]["error"].get<std::string>(), HasSubstr("no texture or object in the region"));
+  EXPECT_THAT(j["antennas"][0]["error"].get<std::string>(),
+              HasSubstr("nothing in the rectangle fits the outline of the model"));
 }
 
 TEST_F(MeasureCli, ARectangleTheAntennaFillsLittleOfIsNamed) {
-  // The antenna's own rectangle, then one 1.8 times as wide and tall about it: the registered
-  // antenna covers a fifth of that (20 %), and another object may have been taken for it.
+  // A rectangle drawn loosely (1.4 times the antenna's about it) still measures it; one 2.6 times
+  // as wide and tall, which the antenna fills to a seventh, names the rectangle: it was drawn
+  // around more than this antenna.
   int x = 0, y = 0, w = 0, h = 0;
   ASSERT_EQ(std::sscanf(roi_.substr(roi_image_.size() + 1).c_str(), "%d,%d,%d,%d", &x, &y, &w, &h), 4);
-  const auto tight = *dir_ / "tight.json";
-  test::run_cli(measure(capture(), fmt::format("--model {} --roi {} --json '{}'", model_, roi_, tight.string())));
-  const auto warnings_of = [](const fs::path& json) {
-    const auto a = nlohmann::json::parse(io::read_text(json))["antennas"][0];
-    EXPECT_TRUE(a["error"].is_null()) << a["error"];
-    return a["warnings"].dump();
+  const auto around = [&](double factor, const char* name) {
+    const int x0 = std::max(0, static_cast<int>(x - (factor - 1) / 2 * w));
+    const int y0 = std::max(0, static_cast<int>(y - (factor - 1) / 2 * h));
+    const int x1 = std::min(960, static_cast<int>(x + (factor + 1) / 2 * w));
+    const int y1 = std::min(720, static_cast<int>(y + (factor + 1) / 2 * h));
+    const auto json = *dir_ / name;
+    test::run_cli(measure(capture(), fmt::format("--model {} --roi {}:{},{},{},{} --json '{}'", model_, roi_image_, x0,
+                                                 y0, x1 - x0, y1 - y0, json.string())));
+    return nlohmann::json::parse(io::read_text(json))["antennas"][0];
   };
-  EXPECT_THAT(warnings_of(tight), ::testing::Not(HasSubstr("of the rectangle")));
-
-  const int x0 = std::max(0, x - 2 * w / 5), y0 = std::max(0, y - 2 * h / 5);
-  const int x1 = std::min(960, x + 7 * w / 5), y1 = std::min(720, y + 7 * h / 5);
-  const auto loose = *dir_ / "loose.json";
-  test::run_cli(measure(capture(), fmt::format("--model {} --roi {}:{},{},{},{} --json '{}'", model_, roi_image_, x0,
-                                               y0, x1 - x0, y1 - y0, loose.string())));
-  EXPECT_THAT(warnings_of(loose), HasSubstr("of the rectangle in"));
+  const auto loose = around(1.4, "loose.json");
+  EXPECT_TRUE(loose["error"].is_null()) << loose["error"];
+  const auto sloppy = around(2.6, "sloppy.json");
+  ASSERT_FALSE(sloppy["error"].is_null());
+  EXPECT_THAT(sloppy["error"].get<std::string>(), HasSubstr("is the rectangle drawn closely around the whole antenna"));
 }
 
 TEST_F(MeasureCli, PhotosWithoutTheBoardAreNamedAndLeftOut) {
@@ -137,12 +140,14 @@ TEST_F(MeasureCli, PhotosAllFromOnePlaceGiveNoConfidentNumber) {
   for (int i = 0; i < 6; ++i) shots += fmt::format("{},{},{}\n", i, t + 0.02 * i, roi_image_);
   test::write_file(cap / "shots.csv", shots);
   const auto json = *dir_ / "one-place.json";
-  const auto r = test::run_cli(measure(cap, fmt::format("--model {} --roi {} --json '{}'", model_, roi_, json.string())));
+  const auto r =
+      test::run_cli(measure(cap, fmt::format("--model {} --roi {} --json '{}'", model_, roi_, json.string())));
   EXPECT_THAT(r.err, HasSubstr("all photos were taken from nearly one direction"));
   EXPECT_EQ(r.status, 3) << r.out << r.err;
   const auto j = nlohmann::json::parse(io::read_text(json));
   EXPECT_TRUE(j["antennas"][0]["azimuth_magnetic_deg"].is_null());
-  EXPECT_FALSE(j["antennas"][0]["error"].is_null());
+  ASSERT_FALSE(j["antennas"][0]["error"].is_null());
+  EXPECT_THAT(j["antennas"][0]["error"].get<std::string>(), HasSubstr("walking a few metres round it"));
 }
 
 TEST_F(MeasureCli, ModelInMillimetresAndOtherBadArgumentsAreNamed) {

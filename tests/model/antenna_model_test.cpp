@@ -99,7 +99,11 @@ TEST(Panel, InvalidSpecsAreRefused) {
   EXPECT_THAT(refusal([](PanelSpec& s) { s.bracket_width_m = 0.26; }),
               HasSubstr("bracket width 0.26 m: must be below the flat part of the back plate"));
   EXPECT_THAT(refusal([](PanelSpec& s) { s.bracket_height_m = 0.7; }),
-              HasSubstr("bracket height 0.7 m: must be below half the panel height"));
+              HasSubstr("bracket height 0.7 m: must be below 0.655 m"));
+  // Brackets 0.1 of the height from the ends: at most 0.262 m tall, or they overhang the ends.
+  EXPECT_THAT(refusal([](PanelSpec& s) { s.bracket_end_fraction = 0.1, s.bracket_height_m = 0.3; }),
+              HasSubstr("bracket height 0.3 m: must be below 0.262 m"));
+  EXPECT_THAT(refusal([](PanelSpec& s) { s.bracket_end_fraction = 0.5; }), HasSubstr("bracket end fraction 0.5"));
   EXPECT_THAT(refusal([](PanelSpec& s) { s.bracket_depth_m = 0; }), HasSubstr("panel bracket size"));
   PanelSpec no_bracket;
   no_bracket.bracket = false, no_bracket.bracket_width_m = 5;  // ignored without brackets
@@ -116,8 +120,31 @@ TEST(Panel, BuiltinsByName) {
   EXPECT_EQ(builtin_panel("panel-1310x300x160").size_m, Vec3(0.30, 0.16, 1.31));
   EXPECT_EQ(builtin_panel("panel-2000x300x150").size_m, Vec3(0.30, 0.15, 2.0));
   const std::string message = test::input_error([] { builtin_panel("yagi"); });
-  EXPECT_THAT(message, HasSubstr("unknown built-in antenna model 'yagi', known: panel-1310x300x160, "
-                                 "thesis-1310x159x80, panel-2000x300x150"));
+  EXPECT_THAT(message, HasSubstr("unknown built-in antenna model 'yagi': expected panel-<h>x<w>x<d>"));
+  EXPECT_THAT(message, HasSubstr("panel-1310x300x160, thesis-1310x159x80, panel-2000x300x150"));
+}
+
+TEST(Panel, AnyDatasheetBoxByName) {
+  const AntennaModel m = builtin_panel("panel-1850x280x120");
+  EXPECT_EQ(m.name, "panel-1850x280x120");
+  EXPECT_EQ(m.size_m, Vec3(0.28, 0.12, 1.85));
+  EXPECT_TRUE(is_closed(m.mesh_antenna));
+  EXPECT_TRUE(is_builtin_panel("panel-1850x280x120"));
+  // The named ones are the same panels as before.
+  const auto [lo, hi] = bounding_box(builtin_panel("panel-2000x300x150").mesh_antenna);
+  EXPECT_LT((lo - Vec3(-0.15, -0.075 - 0.06, -1.0)).norm(), 1e-12);
+  EXPECT_LT((hi - Vec3(0.15, 0.075, 1.0)).norm(), 1e-12);
+  // The extremes of the ranges; the narrowest panel's brackets narrowed to fit its back plate.
+  EXPECT_EQ(builtin_panel("panel-300x100x50").size_m, Vec3(0.1, 0.05, 0.3));
+  EXPECT_EQ(builtin_panel("panel-4000x800x400").size_m, Vec3(0.8, 0.4, 4.0));
+  for (const char* bad : {"panel-299x300x160", "panel-1310x90x60", "panel-1310x300x40", "panel-1310x300x401",
+                          "panel-1310x200x250", "panel-4001x300x160", "panel-1310x300", "panel-1310x300x160x1",
+                          "panel-1310.5x300x160", "panel-01310x300x160", "panel-x300x160", "panel-1310X300X160",
+                          "thesis-1310x160x80"}) {
+    EXPECT_FALSE(is_builtin_panel(bad)) << bad;
+    const std::string message = test::input_error([&] { builtin_panel(bad); });
+    EXPECT_THAT(message, HasSubstr("h 300..4000, w 100..800, d 50..400, d <= w")) << bad;
+  }
 }
 
 TEST(AntennaModel, LoadsAMeshPlacedByItsBoxFile) {

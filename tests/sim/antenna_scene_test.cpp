@@ -1,12 +1,15 @@
-// Meshes in the photo simulator and the antenna scenario: a rendered cube matches its analytic
-// projection and shading, a two-triangle square renders like the equivalent patch, z-order
-// between patches and meshes; antenna captures keep every antenna and the board in every photo,
-// their truth is self-consistent, the device seed fixes the phone, the mast disturbance is
-// position-dependent and bad option values are refused by name.
+// Meshes in the photo simulator and the antenna scenario's classic distribution: a rendered cube
+// matches its analytic projection and shading, a two-triangle square renders like the equivalent
+// patch, z-order between patches and meshes; classic antenna captures keep every antenna and the
+// board in every photo, their truth is self-consistent, the device seed fixes the phone, the mast
+// disturbance is position-dependent, bad option values are refused by name, and a seed still
+// gives the first scenario's capture byte for byte.
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <set>
 
 #include <gmock/gmock.h>
@@ -255,9 +258,11 @@ TEST(SimDipole, FieldIsTheDipoleFormulaAndTheMastDisturbanceHitsItsTarget) {
             deg2rad(0.2));
 }
 
+// The classic distribution: these tests pin its narrow scenes (wide sites: antenna_site_test.cpp).
 CaptureScenario small_antenna_scenario(std::uint64_t seed) {
   CaptureScenario sc;
   sc.scenario = Scenario::kAntenna;
+  sc.distribution = Distribution::kClassic;
   sc.seed = seed;
   sc.device.width = 640, sc.device.height = 480;
   sc.device.supersampling = 1;
@@ -441,8 +446,8 @@ TEST(SimAntennaCli, WritesAGroundCaptureAndNamesBadOptions) {
   test::TempDir dir;
   const std::string out = (dir / "g").string();
   const auto r = test::run_cli("simulate capture -o '" + out +
-                               "' --scenario antenna --setting ground --antennas 2 --radome plain --photos 4 "
-                               "--width 480 --height 360 --supersampling 1 --seed 8 --device-seed 3");
+                               "' --scenario antenna --distribution classic --setting ground --antennas 2 --radome plain "
+                               "--photos 4 --width 480 --height 360 --supersampling 1 --seed 8 --device-seed 3");
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_THAT(r.out, HasSubstr("2 antenna(s) on a ground mast"));
   const YAML::Node scene = YAML::LoadFile((dir / "g/truth/scene.yaml").string());
@@ -464,8 +469,8 @@ TEST(SimAntennaCli, WritesAGroundCaptureAndNamesBadOptions) {
     return far;
   };
   const auto wide = test::run_cli("simulate capture -o '" + (dir / "wide").string() +
-                                  "' --scenario antenna --setting ground --photos 4 --width 480 --height 360 "
-                                  "--supersampling 1 --seed 8 --device-seed 3 --board-max-distance 8");
+                                  "' --scenario antenna --distribution classic --setting ground --photos 4 --width 480 "
+                                  "--height 360 --supersampling 1 --seed 8 --device-seed 3 --board-max-distance 8");
   ASSERT_EQ(wide.status, 0) << wide.err;
   const double near = farthest_photo_from_board_m(scene),
                far = farthest_photo_from_board_m(YAML::LoadFile((dir / "wide/truth/scene.yaml").string()));
@@ -493,6 +498,44 @@ TEST(SimAntennaCli, WritesAGroundCaptureAndNamesBadOptions) {
   EXPECT_THAT(test::input_error([&] { simulate_capture(sc, dir / "scratch"); }), HasSubstr("--antennas"));
   EXPECT_THAT(test::input_error([&] { parse_antenna_setting("sea"); }), HasSubstr("--setting"));
   EXPECT_THAT(test::input_error([&] { parse_radome_look("gold"); }), HasSubstr("--radome"));
+}
+
+// Regression sites are stored as seeds: the classic distribution must draw, render and write
+// exactly what the first antenna scenario did. The hashes (FNV-1a 64 of each file) are those of
+// that scenario's capture with these options, before the wide distribution existed.
+TEST(SimAntennaCli, ClassicReproducesTheFirstScenarioByteForByte) {
+  test::TempDir dir;
+  const auto r = test::run_cli("simulate capture -o '" + (dir / "c").string() +
+                               "' --scenario antenna --distribution classic --seed 7 --setting rooftop --antennas 2 "
+                               "--width 320 --height 240 --supersampling 1 --photos 3");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::vector<std::pair<std::string, std::uint64_t>> expected = {
+      {"board.yaml", 0x008f479983b02b4aULL},
+      {"capture.yaml", 0x60861bced4b9e436ULL},
+      {"shots.csv", 0xb00448a72b2b3fffULL},
+      {"images/img_0000.jpg", 0xfbc97d4a6441c24aULL},
+      {"images/img_0001.jpg", 0x58efb6365db48977ULL},
+      {"images/img_0002.jpg", 0x2d7ab82bdd041e67ULL},
+      {"sensors/accelerometer.csv", 0xf5e0e29ea232592bULL},
+      {"sensors/gyroscope.csv", 0x4cb8238418f4322aULL},
+      {"sensors/magnetometer.csv", 0x4ac0005cdbd23c48ULL},
+      {"truth/device.yaml", 0xc14cd2ab060ef899ULL},
+      {"truth/orientation.csv", 0x6e0656eae68436b4ULL},
+      {"truth/scene.yaml", 0x5edfe7d881b74647ULL},
+  };
+  const auto fnv1a = [](const std::string& bytes) {
+    std::uint64_t h = 0xcbf29ce484222325ULL;
+    for (const unsigned char c : bytes) h = (h ^ c) * 0x100000001b3ULL;
+    return h;
+  };
+  std::size_t files = 0;
+  for (const auto& e : fs::recursive_directory_iterator(dir / "c")) files += e.is_regular_file() ? 1 : 0;
+  EXPECT_EQ(files, expected.size());
+  for (const auto& [file, hash] : expected) {
+    std::ifstream in(dir / "c" / file, std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_EQ(fnv1a(bytes), hash) << file;
+  }
 }
 
 }  // namespace

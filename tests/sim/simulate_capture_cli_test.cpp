@@ -75,5 +75,41 @@ TEST(SimulateCaptureCli, BadValuesNameTheOption) {
   EXPECT_FALSE(fs::exists(dir / "x"));
 }
 
+// The antenna scenario's distribution and the wide draws' fixes: each bad value is named with
+// what was expected; the wide-only fixes refuse the classic distribution.
+TEST(SimulateCaptureCli, WideDistributionFlagsNameTheirValues) {
+  test::TempDir dir;
+  const std::string out = " -o '" + (dir / "x").string() + "' --scenario antenna";
+  const std::vector<std::pair<std::string, std::vector<std::string>>> cases = {
+      {"--distribution narrow", {"--distribution", "'narrow'", "classic or wide"}},
+      {"--photo-scale 0.1", {"--photo-scale", "0.1", "0.25..1"}},
+      {"--photo-scale 1.5", {"--photo-scale", "1.5", "0.25..1"}},
+      {"--arrangement ring", {"--arrangement", "'ring'", "sectors or side-by-side"}},
+      {"--radome chrome", {"--radome", "'chrome'", "plain, weathered or ribbed"}},
+      {"--background forest", {"--background", "'forest'", "sky, buildings or trees"}},
+      {"--light dusk", {"--light", "'dusk'", "sun, low-sun, overcast or shade"}},
+      {"--distribution classic --radome ribbed", {"--radome", "'ribbed'", "--distribution wide"}},
+      {"--distribution classic --light sun", {"--light", "--distribution wide"}},
+      {"--distribution classic --photo-scale 0.5", {"--photo-scale", "--distribution wide"}},
+      {"--distribution classic --arrangement sectors", {"--arrangement", "--distribution wide"}},
+      {"--distribution classic --background sky", {"--background", "--distribution wide"}},
+  };
+  for (const auto& [args, parts] : cases) {
+    const auto r = test::run_cli("simulate capture" + out + " " + args);
+    EXPECT_EQ(r.status, 2) << args << ": " << r.err;
+    for (const auto& part : parts) EXPECT_THAT(r.err, HasSubstr(part)) << args << ": " << r.err;
+  }
+  EXPECT_FALSE(fs::exists(dir / "x"));
+
+  // Wide by default: the photos a resize of the native size, the draws summarised.
+  const auto wide = test::run_cli("simulate capture -o '" + (dir / "w").string() +
+                                  "' --scenario antenna --width 1600 --height 1200 --photo-scale 0.5 --photos 3 "
+                                  "--supersampling 1 --seed 5 --light overcast --background buildings");
+  ASSERT_EQ(wide.status, 0) << wide.err;
+  EXPECT_THAT(wide.out, HasSubstr("3 photos 800x600"));
+  EXPECT_THAT(wide.out, HasSubstr("overcast light, buildings behind"));
+  EXPECT_THAT(io::read_text(dir / "w/truth/scene.yaml"), HasSubstr("distribution: wide"));
+}
+
 }  // namespace
 }  // namespace antpose

@@ -1,5 +1,6 @@
 #include "antpose/camera/camera_model.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include <fmt/core.h>
@@ -61,6 +62,21 @@ std::optional<std::string> CameraIntrinsics::invalid_reason() const {
   if (cx < 0.0 || cx > width || cy < 0.0 || cy > height)
     return fmt::format("principal point ({}, {}) px outside the {}x{} image", cx, cy, width, height);
   return std::nullopt;
+}
+
+std::optional<CameraIntrinsics> rescaled_intrinsics(const CameraIntrinsics& in, int width, int height) {
+  if (width <= 0 || height <= 0 || in.width <= 0 || in.height <= 0) return std::nullopt;
+  const double sx = static_cast<double>(width) / in.width, sy = static_cast<double>(height) / in.height;
+  // The same scale on both axes, up to the rounding of each new side to whole pixels (±½ px
+  // each, the width's carried to the height by the aspect ratio).
+  const double aspect = static_cast<double>(in.height) / in.width;
+  const double tolerance = 0.5 * (std::max(aspect, 1.0 / aspect) + 1.0) + 1e-9;
+  if (std::abs(sx * in.height - height) > tolerance || std::abs(sy * in.width - width) > tolerance) return std::nullopt;
+  CameraIntrinsics out = in;
+  out.width = width, out.height = height;
+  out.fx = in.fx * sx, out.fy = in.fy * sy;
+  out.cx = (in.cx + 0.5) * sx - 0.5, out.cy = (in.cy + 0.5) * sy - 0.5;
+  return out;
 }
 
 Mat3 nominal_R_device_camera() { return Vec3(1.0, -1.0, -1.0).asDiagonal(); }

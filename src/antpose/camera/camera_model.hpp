@@ -20,11 +20,10 @@
 
 namespace antpose::camera {
 
-
 struct CameraIntrinsics {
-  int width = 0, height = 0;  // px
+  int width = 0, height = 0;              // px
   double fx = 0, fy = 0, cx = 0, cy = 0;  // px
-  std::array<double, 5> distortion{};  // k1, k2, p1, p2, k3 (OpenCV order)
+  std::array<double, 5> distortion{};     // k1, k2, p1, p2, k3 (OpenCV order)
 
   Mat3 K() const;
   bool has_distortion() const;
@@ -41,6 +40,14 @@ struct CameraIntrinsics {
   /// image, non-finite values); empty when usable.
   std::optional<std::string> invalid_reason() const;
 };
+
+/// The intrinsics of photos `width` × `height` px taken by the same sensor at another resolution:
+/// the calibrated `intrinsics` scaled by w/W and h/H (pixel centres at (i + ½)·scale − ½), the
+/// distortion unchanged (it acts on normalised coordinates). A phone reading its sensor at a lower
+/// resolution bins or resizes the whole frame, which is exactly this; a crop (16:9 video from a
+/// 4:3 sensor) is not, so the two scales must agree to within the rounding of each side to
+/// whole pixels. nullopt when they do not (another aspect ratio, a crop, or a rotated photo).
+std::optional<CameraIntrinsics> rescaled_intrinsics(const CameraIntrinsics& intrinsics, int width, int height);
 
 /// R_device_camera of a main camera on the back of the phone (Android device frame, camera frame
 /// of the conventions): camera x = device x, camera y = −device y, camera z = −device z.

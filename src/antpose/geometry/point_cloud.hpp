@@ -17,6 +17,14 @@ namespace antpose {
 
 using Iso3 = Eigen::Isometry3d;
 
+/// The rigid transform p ↦ R p + t.
+inline Iso3 isometry(const Mat3& R, const Vec3& t) {
+  Iso3 T = Iso3::Identity();
+  T.linear() = R;
+  T.translation() = t;
+  return T;
+}
+
 struct PointCloud {
   std::vector<Vec3> points;
   std::vector<Vec3> normals;  // empty, or one unit normal per point

@@ -39,9 +39,9 @@ AntennaAttitudeResult antenna_attitude(const BoardWorldAttitude& board, const Ma
 /// truth may lie as far round the panel's own long axis, and about a tilted axis a yaw moves
 /// the roll by about yaw · sin(downtilt) and the downtilt by downtilt · (1 − cos yaw). So each
 /// angle takes the larger of its differences to the rival and to R_board_antenna turned by the
-/// rival's boresight angle about its own z. 5610-1 (3.9° down): 13.8° off about its own axis
-/// read as −0.99° of roll, where a rival 30° round about the vertical had left the roll's σ at
-/// 0.18°. Returns the largest angle between the rivals' boresights and the result's (rad).
+/// rival's boresight angle about its own z (a panel 3.9° down, 13.8° off about its own axis,
+/// reads as −0.99° of roll, where a rival 30° round about the vertical would leave the roll's σ
+/// at 0.18°). Returns the largest angle between the rivals' boresights and the result's (rad).
 double widen_for_rivals(AntennaAttitudeResult& result, const Mat3& R_board_antenna,
                         const std::vector<Mat3>& rivals_board, const BoardWorldAttitude& board,
                         const std::optional<geomag::SiteField>& site);

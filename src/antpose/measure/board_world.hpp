@@ -79,9 +79,9 @@ BoardWorldAttitude board_world_attitude(const std::vector<BoardPhoto>& photos,
 
 struct CompassOptions {
   /// 1σ heading error of a calibrated magnetometer's field direction (hard- and soft-iron
-  /// residuals), rad. On the simulated phone 401 (aligned to its accelerometer) the calibrated
-  /// field at the photos, turned into the world by the true attitudes, pointed −0.02° to +0.13°
-  /// off magnetic north (sites 601, 4204, 4208).
+  /// residuals), rad. On a simulated calibrated typical phone (aligned to its accelerometer) the
+  /// calibrated field at the photos, turned into the world by the true attitudes, pointed −0.02°
+  /// to +0.13° off magnetic north.
   double calibration_sigma_rad = deg2rad(0.15);
   std::size_t min_photos = 2;
 };

@@ -11,7 +11,7 @@
 //  1. against the Earth's field at the site (WMM), photo by photo: strength within
 //     `strength_tolerance`, dip within `dip_tolerance`. The limits must allow WMM's error,
 //     crustal anomalies (~1 %) and the magnetometer's scale calibration, so a turn of 4–8° by a
-//     field perpendicular to B_earth can pass it (acceptance sites 703, 706: −2.7 % and −1.3°);
+//     field perpendicular to B_earth can pass it (simulated: −2.7 % and −1.3° for such turns);
 //  2. along the walk: the Earth's field is uniform over a site (nT per km), a mast's falls off as
 //     1/r³, so photos taken from a few metres apart see different fields. The spread (largest −
 //     smallest) of strength and of dip over the photos is free of WMM's and the calibration's
@@ -19,19 +19,19 @@
 //  3. the part common to all photos, against WMM: the median dip over the photos. From 15–30 m a
 //     mast's field hardly changes along the walk, so test 2 is blind to it; the median leaves
 //     WMM's error (0.2–0.3° in inclination, 1σ, WMM2025 report), crustal anomalies and the
-//     calibration's shape error (acceptance site 1612: the median dip 1.6° above WMM's, every
-//     photo within 2°, the compass turned 3°). The median strength is not tested so tightly: it
+//     calibration's shape error (a simulated mast turning the compass by 3° left every photo's
+//     dip within 2° of WMM's, the median 1.6° above it). The median strength is not tested so tightly: it
 //     carries the magnetometer's overall gain, which the calibration does not fix (det S = 1,
 //     calibration/magnetometer.hpp);
 //  4. a gradient of the strength along the walk: F_i = a + gᵀ h_i over where the phone was (h
 //     the horizontal position, least squares). A trend over the positions is the source's
-//     fall-off, and the fit averages the noise (site 1306: the compass turned 4.7°, strength and
-//     dip near WMM's everywhere, but a 1.0 % change along the walk, fitted well). Flagged when the
+//     fall-off, and the fit averages the noise (a simulated compass turned 4.7°, strength and dip
+//     near WMM's everywhere, but a 1.0 % change along the walk, fitted well). Flagged when the
 //     fitted change exceeds `strength_trend` and its F statistic `trend_significance`;
 //  5. a gradient of the whole field vector: B_i = a + G h_i, the three components at once. Test
 //     4 sees only the part of δB's change along B; the vector also sees its part across B, the
 //     one that turns the compass, because each photo's horizontal direction comes from the
-//     board, not from the compass (site 1712: the compass turned 4.5–5.2°, the strength's trend
+//     board, not from the compass (a simulated compass turned 4.5–5.2°: the strength's trend
 //     0.9 % with F 7.9, the vector's 1.8 % with F 15). Flagged when the fitted change (largest
 //     distance between two photos' fitted vectors, over |B|) exceeds `vector_trend` and the F
 //     statistic of the 2 × 3 slopes `vector_trend_significance`.
@@ -43,7 +43,7 @@
 // photos' median), and the vector's fitted change along the walk, is taken as the size of the
 // unseen horizontal part, over the horizontal field: σ_heading = |δB_seen| / B_h. The
 // disturbances that pass test 1 are those mostly perpendicular to B, so this is rather an
-// underestimate (site 703: 2.2° for a turn of 3–5°); the warning says so.
+// underestimate (simulated: 2.2° for a turn of 3–5°); the warning says so.
 #pragma once
 
 #include <optional>
@@ -59,17 +59,17 @@ namespace antpose::measure {
 struct FieldCheckOptions {
   double strength_tolerance = 0.04;     // against WMM, fraction
   double dip_tolerance = deg2rad(2.0);  // against WMM
-  // Over the photos. On the undisturbed acceptance sites 701–712 the spreads reached 0.64 % and
-  // 1.54° (the dip carries the track's tilt error while walking), on the disturbed 2.2–8.1 %.
+  // Over the photos. On 12 undisturbed simulated sites the spreads reached 0.64 % and 1.54° (the
+  // dip carries the track's tilt error while walking), on the disturbed ones 2.2–8.1 %.
   double strength_spread = 0.015;  // fraction of the median
   double dip_spread = deg2rad(2.5);
-  // Test 3. On the 42 undisturbed sites 601–1604 the median dip was within 0.24° of WMM's.
+  // Test 3. On 42 undisturbed simulated sites the median dip was within 0.24° of WMM's.
   double median_dip_tolerance = deg2rad(1.0);
-  // Test 4. On the 42 undisturbed sites 601–1604 the change fitted along the walk reached 0.50 %
+  // Test 4. On 42 undisturbed simulated sites the change fitted along the walk reached 0.50 %
   // and the F statistic 5.3 (not on the same site); on 18 of 19 disturbed ones 0.86–8.6 %, F ≥ 19.
   double strength_trend = 0.005;     // fraction of the median
   double trend_significance = 10.0;  // F(2, n − 3); 8.0 is p = 0.01 for 12 photos
-  // Test 5. On 80 undisturbed simulated sites (801–1712, the field through the true attitudes)
+  // Test 5. On 80 undisturbed simulated sites (the field through the true attitudes)
   // the vector's fitted change reached 0.70 % and its F 4.4; on all 40 disturbed ones
   // 1.34–13.8 % with F 13.9–186 (through the pipeline: 0.55–0.71 % and F ≤ 5.3 undisturbed).
   double vector_trend = 0.010;             // fraction of the median strength

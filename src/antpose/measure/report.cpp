@@ -230,7 +230,7 @@ void write_report(const fs::path& folder, const Capture& capture, const NonConta
               m.roi.image == shot.image ? cv::Scalar(255, 0, 255) : cv::Scalar(200, 200, 0), 1);
         }
         if (!m.error)
-          draw_overlay(image, scale, setup.intrinsics, result.poses.R_camera_board[i], result.poses.t_camera_board[i],
+          draw_overlay(image, scale, result.intrinsics, result.poses.R_camera_board[i], result.poses.t_camera_board[i],
                        m, setup.model_for(k), static_cast<int>(k + 1));
       }
       const auto name = fmt::format("overlay_{:02d}.jpg", i + 1);

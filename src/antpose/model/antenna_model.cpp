@@ -1,8 +1,11 @@
 #include "antpose/model/antenna_model.hpp"
 
+#include <array>
+#include <cctype>
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <optional>
 #include <stdexcept>
 
 #include <Eigen/Eigenvalues>
@@ -102,11 +105,20 @@ void validate(const PanelSpec& s) {
         fmt::format("panel bracket width {} m: must be below the flat part of the back plate "
                     "(width − 2 · edge radius = {} m)",
                     s.bracket_width_m, flat));
-  if (s.bracket_height_m >= 0.5 * s.height_m)
+  const double f = s.bracket_end_fraction;
+  if (!(f > 0 && f < 0.5))
     throw std::invalid_argument(
-        fmt::format("panel bracket height {} m: must be below half the panel height ({} m) so "
-                    "that the two brackets at 1/4 and 3/4 height do not touch",
-                    s.bracket_height_m, 0.5 * s.height_m));
+        fmt::format("panel bracket end fraction {}: the brackets' centres must lie strictly between the ends "
+                    "and the middle (0 < fraction < 0.5)",
+                    f));
+  // Each bracket between its end and the middle: height below 2 f h (its end) and (1 − 2 f) h
+  // (the other bracket); half the height for brackets at 1/4 and 3/4.
+  const double limit = std::min(2 * f, 1 - 2 * f) * s.height_m;
+  if (s.bracket_height_m >= limit)
+    throw std::invalid_argument(
+        fmt::format("panel bracket height {} m: must be below {} m so that the two brackets, centred {} of the "
+                    "height from each end, neither touch nor overhang the ends",
+                    s.bracket_height_m, limit, f));
 }
 
 // Cross-section of the panel in the x–y plane, counter-clockwise seen from +z (so that the side
@@ -177,9 +189,9 @@ void add_bracket(MeshBuilder& mb, const std::array<std::uint32_t, 4>& hole, doub
 Mesh panel_mesh(const PanelSpec& s) {
   const std::vector<Vec2> ring = cross_section(s);
   const std::size_t n = ring.size();
-  const double h = s.height_m, bh = s.bracket_height_m;
+  const double h = s.height_m, bh = s.bracket_height_m, zb = (0.5 - s.bracket_end_fraction) * h;
   std::vector<double> levels = {-h / 2, h / 2};
-  if (s.bracket) levels = {-h / 2, -h / 4 - bh / 2, -h / 4 + bh / 2, h / 4 - bh / 2, h / 4 + bh / 2, h / 2};
+  if (s.bracket) levels = {-h / 2, -zb - bh / 2, -zb + bh / 2, zb - bh / 2, zb + bh / 2, h / 2};
   const auto is_bracket_band = [&](std::size_t band) { return s.bracket && (band == 1 || band == 3); };
 
   MeshBuilder mb;
@@ -205,16 +217,46 @@ Mesh panel_mesh(const PanelSpec& s) {
   return mb.take();
 }
 
-struct BuiltinPanel {
-  const char* name;
-  double height_m, width_m, depth_m;
-};
+// The named built-ins; any other datasheet box is parsed from its name (datasheet_box).
+constexpr const char* kBuiltinPanels[] = {"panel-1310x300x160", "thesis-1310x159x80", "panel-2000x300x150"};
 
-constexpr BuiltinPanel kBuiltinPanels[] = {
-    {"panel-1310x300x160", 1.31, 0.30, 0.16},
-    {"thesis-1310x159x80", 1.31, 0.159, 0.080},
-    {"panel-2000x300x150", 2.00, 0.30, 0.15},
-};
+// "panel-<h>x<w>x<d>" or "thesis-<h>x<w>x<d>" with whole millimetres: {h, w, d} in mm.
+std::optional<std::array<int, 3>> datasheet_box(const std::string& name, const std::string& prefix) {
+  if (name.rfind(prefix, 0) != 0) return std::nullopt;
+  std::array<int, 3> mm{};
+  std::size_t at = prefix.size();
+  for (std::size_t i = 0; i < 3; ++i) {
+    std::size_t end = at;
+    while (end < name.size() && end - at < 5 && std::isdigit(static_cast<unsigned char>(name[end]))) ++end;
+    if (end == at || name[at] == '0') return std::nullopt;
+    mm[i] = std::stoi(name.substr(at, end - at));
+    if (i < 2 && (end >= name.size() || name[end] != 'x')) return std::nullopt;
+    at = end + (i < 2 ? 1 : 0);
+  }
+  if (at != name.size()) return std::nullopt;
+  return mm;
+}
+
+// The box of a built-in name: the thesis's panel, or a datasheet box within the ranges.
+std::optional<std::array<int, 3>> builtin_box(const std::string& name) {
+  if (name == "thesis-1310x159x80") return datasheet_box(name, "thesis-");
+  const auto mm = datasheet_box(name, "panel-");
+  if (mm && (*mm)[0] >= 300 && (*mm)[0] <= 4000 && (*mm)[1] >= 100 && (*mm)[1] <= 800 && (*mm)[2] >= 50 &&
+      (*mm)[2] <= 400 && (*mm)[2] <= (*mm)[1])
+    return mm;
+  return std::nullopt;
+}
+
+AntennaModel panel_from_box(const std::string& name, const std::array<int, 3>& mm) {
+  PanelSpec spec;
+  spec.height_m = mm[0] / 1000.0, spec.width_m = mm[1] / 1000.0, spec.depth_m = mm[2] / 1000.0;
+  // A panel too narrow for the default brackets: leave 2 cm of the back plate's flat part.
+  const double flat = spec.width_m - 2 * spec.edge_radius_m;
+  if (spec.bracket_width_m >= flat) spec.bracket_width_m = flat - 0.02;
+  AntennaModel model = parametric_panel(spec);
+  model.name = name;
+  return model;
+}
 
 }  // namespace
 
@@ -273,26 +315,20 @@ AntennaModel parametric_panel(const PanelSpec& spec) {
       fmt::format("parametric-{:.0f}x{:.0f}x{:.0f}", spec.height_m * 1e3, spec.width_m * 1e3, spec.depth_m * 1e3);
   model.mesh_antenna = panel_mesh(spec);
   model.size_m = Vec3(spec.width_m, spec.depth_m, spec.height_m);
+  model.panel = std::make_shared<const PanelSpec>(spec);
   return model;
 }
 
 AntennaModel builtin_panel(const std::string& name) {
-  for (const auto& b : kBuiltinPanels) {
-    if (name != b.name) continue;
-    PanelSpec spec;
-    spec.height_m = b.height_m, spec.width_m = b.width_m, spec.depth_m = b.depth_m;
-    AntennaModel model = parametric_panel(spec);
-    model.name = name;
-    return model;
-  }
-  throw InputError(fs::path(), fmt::format("unknown built-in antenna model '{}', known: {}", name,
-                                           fmt::join(builtin_panel_names(), ", ")));
+  if (const auto mm = builtin_box(name)) return panel_from_box(name, *mm);
+  throw InputError(fs::path(), fmt::format("unknown built-in antenna model '{}': expected panel-<h>x<w>x<d>, a "
+                                           "datasheet box height x width x depth in whole mm (h 300..4000, w "
+                                           "100..800, d 50..400, d <= w; e.g. panel-1850x280x120), or one of: {}",
+                                           name, fmt::join(builtin_panel_names(), ", ")));
 }
 
-std::vector<std::string> builtin_panel_names() {
-  std::vector<std::string> names;
-  for (const auto& b : kBuiltinPanels) names.emplace_back(b.name);
-  return names;
-}
+bool is_builtin_panel(const std::string& name) { return builtin_box(name).has_value(); }
+
+std::vector<std::string> builtin_panel_names() { return {std::begin(kBuiltinPanels), std::end(kBuiltinPanels)}; }
 
 }  // namespace antpose::model

@@ -9,6 +9,7 @@
 #pragma once
 
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -19,11 +20,16 @@
 
 namespace antpose::model {
 
+struct PanelSpec;
+
 struct AntennaModel {
   std::string name;
   Mesh mesh_antenna;                       // vertices in the antenna frame, metres
   Vec3 size_m = Vec3::Zero();              // the box: width along x_a, depth along y_a, height along z_a
   Iso3 T_antenna_mesh = Iso3::Identity();  // file coordinates (in metres) → antenna frame; identity for built-ins
+  /// A parametric panel's spec (built-ins and datasheet boxes): its edge rounding and brackets are
+  /// a guess, which the registration may refit; none for a mesh from a file.
+  std::shared_ptr<const PanelSpec> panel;
 };
 
 /// Loads a model from a mesh file (read_mesh: OBJ or PLY in `units`, size-checked) that has
@@ -49,25 +55,36 @@ AntennaBox principal_axes_box(const Mesh& mesh);
 struct PanelSpec {
   double width_m = 0.30, depth_m = 0.16, height_m = 1.31;
   double edge_radius_m = 0.02;  // rounded vertical edges; 0 for sharp ones
-  bool bracket = true;          // two blocks on the back plate, centred at 1/4 and 3/4 of the height
+  bool bracket = true;          // two blocks on the back plate
   double bracket_width_m = 0.10, bracket_depth_m = 0.06, bracket_height_m = 0.12;  // along x_a, −y_a, z_a
-  int arc_segments = 6;                                                            // flat facets per rounded edge
+  /// The brackets' centres lie this fraction of the height from each end (1/4: at 1/4 and 3/4 of
+  /// the height).
+  double bracket_end_fraction = 0.25;
+  int arc_segments = 6;  // flat facets per rounded edge
 };
 
 /// The closed, outward-wound triangle mesh of a panel in the antenna frame: box centre at the
 /// origin, radome at +y, top at +z; the rounded edges are inscribed polygons (vertices on the
 /// arcs). The brackets protrude from the back plate (−y) outside the box, so size_m is the box
 /// (width, depth, height) without them, like a box fitted by hand to a scan. Two equal brackets
-/// at ±height/4 keep the panel symmetric under a half-turn about y_a (up/down is told by gravity,
-/// not by shape) and break the front/back symmetry. std::invalid_argument for a non-positive
-/// size, a radius not below half the smaller of width and depth, fewer than 1 arc segment, or a
-/// bracket that is not narrower than the flat part of the back plate or not shorter than height/2.
+/// at the same distance from each end keep the panel symmetric under a half-turn about y_a
+/// (up/down is told by gravity, not by shape) and break the front/back symmetry.
+/// std::invalid_argument for a non-positive size, a radius not below half the smaller of width
+/// and depth, fewer than 1 arc segment, or a bracket that is not narrower than the flat part of
+/// the back plate, whose end fraction is not in (0, 1/2), or that does not fit between its end
+/// and the other bracket (for brackets at 1/4 and 3/4: not shorter than height/2).
 AntennaModel parametric_panel(const PanelSpec& spec);
 
-/// Built-in panels by name, height × width × depth in mm: "panel-1310x300x160",
-/// "thesis-1310x159x80" (the thesis's scanned panel), "panel-2000x300x150"; other PanelSpec
-/// fields at their defaults. InputError listing the known names for any other name.
+/// Built-in panels by name: "thesis-1310x159x80" (the thesis's scanned panel) and any datasheet
+/// box "panel-<h>x<w>x<d>", height × width × depth in whole millimetres (h 300..4000, w 100..800,
+/// d 50..400, d ≤ w), such as "panel-1310x300x160" and "panel-2000x300x150". Other PanelSpec fields
+/// at their defaults, except that the brackets of a narrow panel are narrowed to leave 2 cm of the
+/// back plate's flat part beside them. InputError naming the expected form and the ranges for
+/// any other name.
 AntennaModel builtin_panel(const std::string& name);
+/// Whether builtin_panel accepts the name.
+bool is_builtin_panel(const std::string& name);
+/// The named built-ins (a few of the datasheet boxes builtin_panel accepts).
 std::vector<std::string> builtin_panel_names();
 
 }  // namespace antpose::model

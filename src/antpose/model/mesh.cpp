@@ -582,6 +582,12 @@ Mesh transformed(const Mesh& mesh, const Iso3& T) {
   return out;
 }
 
+void append_mesh(Mesh& mesh, const Mesh& part) {
+  const auto offset = static_cast<std::uint32_t>(mesh.vertices.size());
+  mesh.vertices.insert(mesh.vertices.end(), part.vertices.begin(), part.vertices.end());
+  for (const auto& t : part.triangles) mesh.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+}
+
 std::pair<Vec3, Vec3> bounding_box(const Mesh& mesh) {
   if (mesh.vertices.empty()) return {Vec3::Zero(), Vec3::Zero()};
   Vec3 lo = mesh.vertices.front(), hi = lo;

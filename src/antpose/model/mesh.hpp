@@ -63,6 +63,8 @@ void write_ply(const PointCloud& cloud, const std::filesystem::path& file);
 
 /// The mesh with every vertex mapped by T (p' = T p); triangles unchanged.
 Mesh transformed(const Mesh& mesh, const Iso3& T);
+/// Appends `part` to `mesh` (its triangles re-indexed): one mesh of several closed parts.
+void append_mesh(Mesh& mesh, const Mesh& part);
 /// Axis-aligned bounding box (min, max) of the vertices; both zero for an empty mesh.
 std::pair<Vec3, Vec3> bounding_box(const Mesh& mesh);
 /// Area of triangle i (m²) and its unit normal by winding (zero for a degenerate triangle).

@@ -233,10 +233,9 @@ RefinedPoses refine_camera_poses(const std::vector<PosedView>& views, const came
     so.linear_solver_type = ceres::DENSE_SCHUR;
     so.dense_linear_algebra_library_type = ceres::EIGEN;
     so.max_num_iterations = options.max_iterations;
-    // One thread: with two, runs of `antpose measure` on the same photos differed, and near-ties
-    // downstream turned on it (1805-3's start among panel hypotheses scoring alike: answered in
-    // two runs of six); with one, three runs agreed to the last bit. The same photos must give
-    // the same numbers. The problem is small (12 cameras, ~1000 tracks): it costs ~0.1 s.
+    // One thread: with two, runs of `antpose measure` on the same photos differed in the last
+    // bits, and near-ties downstream turned on them; with one, runs agree to the last bit. The
+    // same photos must give the same numbers. The problem is small (12 cameras, ~1000 tracks): it costs ~0.1 s.
     so.num_threads = 1;
     so.logging_type = ceres::SILENT;
     ceres::Solver::Summary summary;
@@ -343,9 +342,9 @@ RefinedPoses refine_camera_poses(const std::vector<PosedView>& views, const came
   // The board is the reference: true tracks move the cameras within what its corners allow, so
   // its residual barely grows (0.04–0.05 px after the solve on 74 of 75 simulated sites). False
   // tracks that agree with each other (a moiré on ground seen at a grazing angle, something that
-  // moved) can bend all the poses together instead: on site 3802 they turned the cameras
-  // 0.03–0.10° from the truth (0.004–0.018° on the board alone), the board's RMS went from 0.05
-  // to 0.17 px, and a panel 20 m away came out 1.4° off in downtilt. Then the poses are the
+  // moved) can bend all the poses together instead: turning the cameras 0.03–0.10° from the truth
+  // (0.004–0.018° on the board alone), the board's RMS growing from 0.05 to 0.17 px, and a panel
+  // 20 m away coming out 1.4° off in downtilt. Then the poses are the
   // board's alone.
   const double board_rms_with_scene = board_rms().first;
   const bool scene_rejected =

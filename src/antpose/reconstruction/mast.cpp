@@ -96,6 +96,12 @@ struct EdgeView {
   Vec3 centre_board = Vec3::Zero();
   Vec2 offset = Vec2::Zero();  // crop origin, px
   cv::Mat gx, gy;
+  cv::Mat hidden;  // CV_8UC1, non-zero where a known nearer object hides the mast (may be empty)
+
+  bool hides(const Vec2& q_crop) const {
+    const int x = static_cast<int>(std::lround(q_crop.x())), y = static_cast<int>(std::lround(q_crop.y()));
+    return !hidden.empty() && x >= 0 && y >= 0 && x < hidden.cols && y < hidden.rows && hidden.at<std::uint8_t>(y, x);
+  }
 };
 
 // An edge found along an outline line: the ray through it (board frame) is tangent to the mast.
@@ -284,6 +290,11 @@ std::size_t outline_tangencies(const std::vector<EdgeView>& edge_views, const Ho
       const Vec2 along = (*b - *a).normalized(), normal(-along.y(), along.x());
       for (int j = 0; j < n; ++j) {
         const Vec2 q = *a + (*b - *a) * ((j + 0.5) / n);
+        const Vec2 in_crop = q - ev.offset;
+        // Out of the photo, or where a known nearer object hides the mast: not measurable.
+        if (in_crop.x() < 0 || in_crop.y() < 0 || in_crop.x() > ev.gx.cols - 1 || in_crop.y() > ev.gx.rows - 1 ||
+            ev.hides(in_crop))
+          continue;
         ++sampled;
         const auto edge =
             camera::nearest_edge(ev.gx, ev.gy, q - ev.offset, normal, camera::EdgeSearchSpan::symmetric(search_px),
@@ -295,6 +306,43 @@ std::size_t outline_tangencies(const std::vector<EdgeView>& edge_views, const Ho
     }
   }
   return sampled;
+}
+
+// A photo's gradients around a cylinder's two outline lines from z_low to z_high, cropped to
+// their reach (the largest radius either side) and zeroed on known nearer objects; false where
+// the outline falls outside the photo.
+bool outline_crop(EdgeView& ev, const Horizontal& h, const Vec2& axis, double z_low, double z_high,
+                  const camera::CameraIntrinsics& K, const MastOptions& o,
+                  const std::vector<std::vector<cv::Point2f>>& occluders) {
+  const PosedView& v = *ev.view;
+  const auto a = project(K, v, h.point(axis, z_low)), b = project(K, v, h.point(axis, z_high));
+  if (!a || !b || (*b - *a).norm() < 4.0) return false;
+  const double px_per_m = 0.5 * (K.fx + K.fy) / std::max((h.of(ev.centre_board) - axis).norm(), 0.1);
+  const Vec2 along = (*b - *a).normalized(), normal(-along.y(), along.x());
+  const double reach = 2.0 * o.max_radius_m * px_per_m + 4.0 + o.search_px.front();
+  std::vector<cv::Point2f> corners;
+  for (const Vec2& q : {*a, *b})
+    for (const double k : {-reach, reach})
+      corners.emplace_back(static_cast<float>(q.x() + k * normal.x()), static_cast<float>(q.y() + k * normal.y()));
+  const cv::Rect box = cv::boundingRect(corners) & cv::Rect(0, 0, v.image.cols, v.image.rows);
+  if (box.width < 8 || box.height < 8) return false;
+  ev.offset = Vec2(box.x, box.y);
+  std::tie(ev.gx, ev.gy) =
+      camera::smoothed_gradients(camera::linear_intensity(v.image(box), o.gamma), o.smoothing_sigma_px);
+  if (occluders.empty()) return true;
+  cv::Mat mask = cv::Mat::zeros(box.size(), CV_8UC1);
+  for (const auto& poly : occluders) {
+    std::vector<cv::Point> q;
+    for (const auto& c : poly)
+      q.emplace_back(static_cast<int>(std::lround(c.x - box.x)), static_cast<int>(std::lround(c.y - box.y)));
+    if (q.size() >= 3) cv::fillPoly(mask, std::vector<std::vector<cv::Point>>{q}, 255);
+  }
+  // A known object's blurred border would pass for an edge: a few pixels more.
+  cv::dilate(mask, mask, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(7, 7)));
+  ev.gx.setTo(0, mask);
+  ev.gy.setTo(0, mask);
+  ev.hidden = mask;
+  return true;
 }
 
 // The cylinder p = (axis x, y, radius) tangent to the rays (Ceres, Cauchy loss).
@@ -347,15 +395,37 @@ std::optional<Mast> fit_mast(const PointCloud& points_board, const Vec3& up_boar
   }
   double p[3] = {median(cx), median(cy), r0};
   fit_tangencies(found, h, o, p);
+  const Mast start = cylinder(h, *seen, Vec2(p[0], p[1]), p[2], std::min(z_low, seen->low - o.extend_m),
+                              std::max(z_high, seen->high + o.extend_m));
+  return confirm_mast(start, views, K, z_low, z_high, {}, o);
+}
 
-  // Stage 2b: every outline sample, the nearest edge within a shrinking range.
+std::optional<Mast> confirm_mast(const Mast& start, const std::vector<PosedView>& views,
+                                 const camera::CameraIntrinsics& K, double outline_low_m, double outline_high_m,
+                                 const std::vector<std::vector<std::vector<cv::Point2f>>>& occluders,
+                                 const MastOptions& o) {
+  const Horizontal h(start.up_board);
+  const double z_low = outline_low_m, z_high = outline_high_m;
+  const Vec2 axis0 = h.of(start.axis_point_board);
+  double p[3] = {axis0.x(), axis0.y(), start.radius_m};
+  // Every photo's gradients around the cylinder's outline, known nearer objects masked.
+  std::vector<EdgeView> edge_views;
+  const std::vector<std::vector<cv::Point2f>> none;
+  for (std::size_t i = 0; i < views.size(); ++i) {
+    EdgeView ev;
+    ev.view = &views[i];
+    ev.centre_board = camera::camera_centre(views[i].R_camera_board, views[i].t_camera_board);
+    if (outline_crop(ev, h, axis0, z_low, z_high, K, o, i < occluders.size() ? occluders[i] : none))
+      edge_views.push_back(std::move(ev));
+  }
+  // Every outline sample, the nearest edge within a shrinking range.
+  std::vector<Tangency> found;
   std::size_t sampled = 0;
   for (const double search : o.search_px) {
     sampled = outline_tangencies(edge_views, h, p, z_low, z_high, search, K, o, found);
     if (found.size() < 3) return std::nullopt;
     fit_tangencies(found, h, o, p);
   }
-
   // Confirmation by the last round's samples.
   std::vector<std::size_t> per_view(edge_views.size(), 0);
   double ss = 0.0;
@@ -366,8 +436,9 @@ std::optional<Mast> fit_mast(const PointCloud& points_board, const Vec3& up_boar
     if (std::abs(r) > 2.0 * o.loss_px) continue;
     ss += r * r, ++inliers, ++per_view[t.view];
   }
-  Mast mast = cylinder(h, *seen, Vec2(p[0], p[1]), p[2], std::min(z_low, seen->low - o.extend_m),
-                       std::max(z_high, seen->high + o.extend_m));
+  Mast mast = start;
+  mast.axis_point_board = h.point(Vec2(p[0], p[1]), h.up.dot(start.axis_point_board));
+  mast.radius_m = p[2];
   mast.views = static_cast<std::size_t>(std::count_if(per_view.begin(), per_view.end(), [](auto n) { return n >= 5; }));
   mast.edge_samples = inliers;
   mast.edge_rms_px = inliers ? std::sqrt(ss / static_cast<double>(inliers)) : 0.0;

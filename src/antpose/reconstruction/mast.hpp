@@ -75,6 +75,16 @@ std::optional<Mast> fit_mast(const PointCloud& points_board, const Vec3& up_boar
                              const camera::CameraIntrinsics& intrinsics, double outline_low_m, double outline_high_m,
                              const MastOptions& options);
 
+/// Stage 2 alone from a cylinder found some other way (mast_search.hpp): its outline refined and
+/// confirmed in the photos as fit_mast's, between the heights `outline_low_m` and `outline_high_m`,
+/// with `occluders[i]` (image polygons, px) masked in photo i — the antenna itself, whose vertical
+/// edges would pass for the mast's. nullopt when the outline does not confirm it.
+std::optional<Mast> confirm_mast(const Mast& start, const std::vector<PosedView>& views,
+                                 const camera::CameraIntrinsics& intrinsics, double outline_low_m,
+                                 double outline_high_m,
+                                 const std::vector<std::vector<std::vector<cv::Point2f>>>& occluders,
+                                 const MastOptions& options);
+
 /// Stage 1 alone: the vertical cylinder that most of `points_board` lie on, over their height
 /// range, unconfirmed by the photos (views 0); nullopt where none holds options.min_points over
 /// options.min_height_m. From afar its radius is rough (the points scatter in depth).

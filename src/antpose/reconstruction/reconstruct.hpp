@@ -96,6 +96,13 @@ struct RegionOptions {
   /// board itself when the rectangle overlaps it (nearer, and far better textured, it would
   /// otherwise be taken for the object).
   std::optional<std::pair<Vec3, Vec3>> exclude_board;
+  /// The depth range (near, far along the region camera's axis, m) where the caller expects the
+  /// object, e.g. from the model's size against the rectangle's: used where the features give no
+  /// object's depth (a plain radome has a handful).
+  std::optional<std::pair<double, double>> expected_depth_m;
+  /// Where no object gives min_points, the nearest object's few points are returned with a
+  /// warning instead of an error: a model's outline may still place the antenna.
+  bool allow_few_points = false;
 };
 
 struct RegionReconstruction {
@@ -118,7 +125,8 @@ struct RegionReconstruction {
 /// remain (the message says which, e.g. "no texture or object in the region"). The object is the
 /// nearest one in the rectangle; where its surface gives too few points (the roof's edge reaching
 /// into the rectangle, or false matches between an antenna's two equal brackets), the object
-/// beyond it, and so on up to options.max_objects, with a warning.
+/// beyond it, and so on up to options.max_objects, with a warning; where none gives enough, the
+/// nearest object's few points with a warning (options.allow_few_points) or MeasurementError.
 RegionReconstruction reconstruct_region(const std::vector<PosedView>& views, const RefinedPoses& poses,
                                         std::size_t roi_view, const Roi& roi,
                                         const camera::CameraIntrinsics& intrinsics, const RegionOptions& options,

@@ -47,8 +47,8 @@ namespace detail {
 // Nearest, not densest: whatever else a rectangle drawn around an antenna holds (sky, ground,
 // buildings, trees) lies behind the antenna, and may carry more texture than its radome. The
 // fifth rules out a few stray triangulations nearer than the object (the board's edge); but a
-// textured wall behind a panel may hold more than five times its features (2803-2: ~30 on the
-// panel 4.2 m away, 295 on a wall at 12–18 m), and kObjectSupport in one window are an object.
+// textured wall behind a panel may hold more than five times its features (~30 on a panel 4.2 m
+// away against 295 on a wall at 12–18 m), and kObjectSupport in one window are an object.
 std::optional<DepthRange> nearest_depth_cluster(const std::vector<Vec3>& points_board, const Mat3& R, const Vec3& t,
                                                 std::size_t min_support) {
   if (points_board.empty()) return std::nullopt;
@@ -404,16 +404,33 @@ std::vector<Vec3> statistical_outlier_removal(const std::vector<Vec3>& points, i
 
 namespace {
 
-// The object's surface gave too few points: `range` is the depth range it was sought in.
-class TooFewPoints : public MeasurementError {
- public:
-  TooFewPoints(const std::string& message, const DepthRange& range) : MeasurementError(message), range(range) {}
+// What one object's reconstruction gave: its region, or why not — no object's depth among the
+// features, or too few points on its surface (the region then holds those it gave). `range`: the
+// depth range it was sought in.
+struct ObjectAttempt {
+  enum class Outcome { kFound, kTooFewPoints, kNoObject };
+  Outcome outcome = Outcome::kFound;
+  RegionReconstruction region;
   DepthRange range;
+  std::string reason;
 };
 
+// The caller's expected depth range as the object's, centred on the rectangle's middle ray.
+std::optional<DepthRange> expected_range(const RegionOptions& o, const Roi& roi, const Mat3& R, const Vec3& t,
+                                         const camera::CameraIntrinsics& K) {
+  if (!o.expected_depth_m) return std::nullopt;
+  const auto [near, far] = *o.expected_depth_m;
+  const Vec3 ray = K.ray(Vec2(roi.x + 0.5 * roi.width - 0.5, roi.y + 0.5 * roi.height - 0.5));
+  DepthRange range;
+  range.near = near, range.far = far;
+  range.centre_board = R.transpose() * (ray / ray.z() * (0.5 * (near + far)) - t);
+  return range;
+}
+
 // reconstruct_region without the fallback to the next object: the object is the nearest one more
-// than options.beyond_m from the region's camera (along its axis).
-RegionReconstruction reconstruct_object(const std::vector<PosedView>& views, const RefinedPoses& poses,
+// than options.beyond_m from the region's camera (along its axis). MeasurementError for a region
+// outside the photo or seen in fewer than two photos.
+ObjectAttempt reconstruct_object(const std::vector<PosedView>& views, const RefinedPoses& poses,
                                         std::size_t roi_view, const Roi& roi_in,
                                         const camera::CameraIntrinsics& intrinsics, const RegionOptions& options,
                                         const Progress& progress) {
@@ -511,12 +528,21 @@ RegionReconstruction reconstruct_object(const std::vector<PosedView>& views, con
   std::vector<Vec3> candidates;
   for (const Vec3& p : sparse)
     if ((Rr * p + tr).z() > options.beyond_m) candidates.push_back(p);
-  const auto range = detail::nearest_depth_cluster(candidates, Rr, tr, kMinSparse);
-  if (!range || range->support < kMinSparse)
-    throw MeasurementError(fmt::format(
-        "no texture or object in the region of {}: only {} feature points could be triangulated there (at least {} "
-        "on one object are needed to find its distance); draw the region tightly around the antenna",
-        ref.name, range ? range->support : 0, kMinSparse));
+  auto range = detail::nearest_depth_cluster(candidates, Rr, tr, kMinSparse);
+  if (!range || range->support < kMinSparse) {
+    const auto expected = options.beyond_m <= 0.0 ? expected_range(options, roi, Rr, tr, intrinsics) : std::nullopt;
+    if (!expected)
+      return {ObjectAttempt::Outcome::kNoObject, {}, {},
+              fmt::format("no texture or object in the region of {}: only {} feature points could be triangulated "
+                          "there (at least {} on one object are needed to find its distance); draw the region "
+                          "tightly around the antenna",
+                          ref.name, range ? range->support : 0, kMinSparse)};
+    range = expected;
+    out.warnings.push_back(
+        fmt::format("too few features in the region of {} to find the object's distance: it is sought where the "
+                    "model fills the rectangle ({:.1f}–{:.1f} m)",
+                    ref.name, expected->near, expected->far));
+  }
   DenseContext ctx{&views, &poses, &intrinsics, roi_view, roi, *range, {}, options.max_depth_m, &options};
   ctx.volume = frustum_samples(roi, Rr, tr, intrinsics, {range->near, 0.5 * (range->near + range->far), range->far});
   out.depth_near_m = range->near;
@@ -644,13 +670,17 @@ RegionReconstruction reconstruct_object(const std::vector<PosedView>& views, con
     d.points = dense;
     return registration::voxel_downsample(d, options.voxel_m).size();
   }();
-  if (cloud.size() < options.min_points)
-    throw TooFewPoints(
-        fmt::format("no texture or object in the region of {}: only {} points remain after matching and filtering "
-                    "(at least {} are needed); a plain, untextured radome gives too few points — add photos closer "
-                    "to it or draw the region tightly around the antenna",
-                    ref.name, cloud.size(), options.min_points),
-        *range);
+  if (cloud.size() < options.min_points) {
+    const auto message = fmt::format(
+        "no texture or object in the region of {}: only {} points remain after matching and filtering "
+        "(at least {} are needed); a plain, untextured radome gives too few points — add photos closer "
+        "to it or draw the region tightly around the antenna",
+        ref.name, cloud.size(), options.min_points);
+    out.cloud_board = std::move(cloud);
+    out.views_used = std::count(contributed.begin(), contributed.end(), 1);
+    out.method = "features";
+    return {ObjectAttempt::Outcome::kTooFewPoints, std::move(out), *range, message};
+  }
   out.method = dense_voxels >= cloud.size() / 2 ? (sparse_in.empty() ? "dense" : "dense+features") : "features";
   // Coverage: the fraction of cells (≥ 8 × 8 px) inside the convex hull of the points' projections
   // in the reference view (the object's outline, roughly) that hold a point. A plain radome
@@ -703,44 +733,45 @@ RegionReconstruction reconstruct_object(const std::vector<PosedView>& views, con
   }
   out.cloud_board = std::move(cloud);
   out.views_used = std::count(contributed.begin(), contributed.end(), 1);
-  return out;
+  return {ObjectAttempt::Outcome::kFound, std::move(out), *range, {}};
 }
 
 }  // namespace
 
 // The nearest object in the rectangle is the antenna's (detail::nearest_depth_cluster), but an
-// object nearer than the antenna may reach into it: on site 501 (a rooftop panel 6.6 m away) the
-// rectangle's end held the roof's edge 1.4–3.3 m away, whose 18 features made the nearest
-// cluster, and the dense stage found nothing there. Where the nearest object's surface gives too
-// few points, the next object beyond it is reconstructed instead, with a warning, and so on:
-// on 6003-2 (a thesis panel 9.3 m away on a rooftop) the features made clusters at 2.0–2.6 m
-// (the board's tripod, 2.3 m away) and at 6.7–8.6 m, where the scene holds nothing (false
-// matches), before the panel at 8.4–10.2 m; no two dense pairs agreed on either.
+// object nearer than the antenna may reach into it: a roof's edge or parapet across the end of the
+// rectangle, the board's tripod, or false matches at depths where the scene holds nothing. Where
+// the nearest object's surface gives too few points, the next object beyond it is reconstructed
+// instead, with a warning, and so on.
 RegionReconstruction reconstruct_region(const std::vector<PosedView>& views, const RefinedPoses& poses,
                                         std::size_t roi_view, const Roi& roi,
                                         const camera::CameraIntrinsics& intrinsics, const RegionOptions& options,
                                         const Progress& progress) {
-  std::string nearest;              // why the nearest object gave too few points
+  std::string nearest;  // why the nearest object gave too few points
+  std::optional<RegionReconstruction> nearest_partial;
   std::vector<std::string> passed;  // the depth ranges that gave too few points
   RegionOptions here = options;
   for (int k = 0; k < std::max(1, options.max_objects); ++k) {
-    try {
-      auto out = reconstruct_object(views, poses, roi_view, roi, intrinsics, here, progress);
+    auto attempt = reconstruct_object(views, poses, roi_view, roi, intrinsics, here, progress);
+    if (attempt.outcome == ObjectAttempt::Outcome::kFound) {
       if (!passed.empty())
-        out.warnings.insert(out.warnings.begin(),
-                            fmt::format("the nearer object(s) in the region of {}, {} m from the camera, gave too few "
-                                        "points for an antenna (the roof's edge, a parapet, false matches?): the "
-                                        "object beyond was reconstructed; check the model drawn over the photos",
-                                        views[roi_view].name, fmt::join(passed, " and ")));
-      return out;
-    } catch (const TooFewPoints& e) {
-      if (nearest.empty()) nearest = e.what();
-      passed.push_back(fmt::format("{:.1f}–{:.1f}", e.range.near, e.range.far));
-      here.beyond_m = e.range.far;
-    } catch (const MeasurementError&) {
-      if (nearest.empty()) throw;
-      break;  // nothing beyond
+        attempt.region.warnings.insert(
+            attempt.region.warnings.begin(),
+            fmt::format("the nearer object(s) in the region of {}, {} m from the camera, gave too few points for an "
+                        "antenna (the roof's edge, a parapet, false matches?): the object beyond was reconstructed; "
+                        "check the model drawn over the photos",
+                        views[roi_view].name, fmt::join(passed, " and ")));
+      return std::move(attempt.region);
     }
+    if (nearest.empty()) nearest = attempt.reason;
+    if (attempt.outcome == ObjectAttempt::Outcome::kNoObject) break;  // nothing beyond
+    if (!nearest_partial) nearest_partial = std::move(attempt.region);
+    passed.push_back(fmt::format("{:.1f}–{:.1f}", attempt.range.near, attempt.range.far));
+    here.beyond_m = attempt.range.far;
+  }
+  if (options.allow_few_points && nearest_partial) {
+    nearest_partial->warnings.push_back(nearest + " (the model's outline alone places the antenna)");
+    return std::move(*nearest_partial);
   }
   throw MeasurementError(nearest);  // the nearest object's reason: nothing beyond it did better
 }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <stdexcept>
 #include <tuple>
@@ -168,6 +169,84 @@ double edge_cost(std::optional<double> r_px, const SilhouetteOptions& o) {
   return r_px ? std::min(1.0, (*r_px * *r_px) / (o.score_cutoff_px * o.score_cutoff_px)) : 1.0;
 }
 
+// The model's projection in one photo as a mask (for a closed mesh its front faces alone cover it:
+// every line of sight into the solid enters through one), edges subdivided so that the
+// distortion's bowing is kept; over the projection's own box (so that the outer-contour test also
+// works outside the crop, where samples are counted as unmeasurable), at most ~1000 px. With the
+// vertices' projections; nullopt where part of the model is behind the camera.
+struct ProjectionMask {
+  cv::Mat mask;
+  Vec2 origin = Vec2::Zero();
+  double ms = 1.0;  // image px per mask px
+  std::vector<std::optional<Vec2>> uv;
+
+  Vec2 to_mask(const Vec2& p) const { return Vec2((p.x() - origin.x()) / ms, (p.y() - origin.y()) / ms); }
+  bool inside(const Vec2& q) const {
+    const int x = round_px(q.x()), y = round_px(q.y());
+    return x >= 0 && y >= 0 && x < mask.cols && y < mask.rows && mask.at<std::uint8_t>(y, x) != 0;
+  }
+};
+
+std::optional<ProjectionMask> project_model(const EdgeMesh& m, const Pose& pose, const PreparedView& v,
+                                            const camera::CameraIntrinsics& K, const std::vector<char>& front) {
+  ProjectionMask out;
+  out.uv.resize(m.vertices.size());
+  Vec2 lo = Vec2::Constant(1e300), hi = Vec2::Constant(-1e300);
+  for (std::size_t i = 0; i < m.vertices.size(); ++i) {
+    out.uv[i] = project(K, v, pose.R * m.vertices[i] + pose.t);
+    if (!out.uv[i]) return std::nullopt;
+    lo = lo.cwiseMin(*out.uv[i]), hi = hi.cwiseMax(*out.uv[i]);
+  }
+  const double pad = 8 + 0.05 * (hi - lo).maxCoeff();
+  out.origin = lo - Vec2::Constant(pad);
+  const Vec2 extent = hi - lo + Vec2::Constant(2 * pad);
+  if (!(extent.maxCoeff() < 1e5)) return std::nullopt;  // a degenerate projection (model at the camera)
+  out.ms = std::max(1.0, extent.maxCoeff() / 1000.0);
+  out.mask = cv::Mat::zeros(static_cast<int>(std::ceil(extent.y() / out.ms)) + 1,
+                            static_cast<int>(std::ceil(extent.x() / out.ms)) + 1, CV_8UC1);
+  std::vector<cv::Point> poly;
+  for (std::size_t f = 0; f < m.triangles.size(); ++f) {
+    if (m.closed && !front[f]) continue;
+    const auto& t = m.triangles[f];
+    poly.clear();
+    for (int k = 0; k < 3; ++k) {
+      const Vec3 A = pose.R * m.vertices[t[k]] + pose.t, B = pose.R * m.vertices[t[(k + 1) % 3]] + pose.t;
+      const double len = (*out.uv[t[(k + 1) % 3]] - *out.uv[t[k]]).norm() / out.ms;
+      const int n = std::clamp(static_cast<int>(std::ceil(len / 8.0)), 1, 64);
+      for (int j = 0; j < n; ++j) {
+        const auto p = project(K, v, A + (B - A) * (double(j) / n));
+        if (!p) return std::nullopt;
+        const Vec2 q = out.to_mask(*p) * 4.0;  // shift = 2: quarter-pixel vertices
+        poly.emplace_back(round_px(q.x()), round_px(q.y()));
+      }
+    }
+    const cv::Point* vertices = poly.data();
+    const int count = static_cast<int>(poly.size());
+    cv::fillPoly(out.mask, &vertices, &count, 1, cv::Scalar(255), cv::LINE_8, 2);
+  }
+  return out;
+}
+
+// d(projection · normal)/d(δ, δt) of the point X (board frame) of the model at `pose`, by central
+// differences in the camera frame (distortion included).
+std::optional<Eigen::Matrix<double, 1, 6>> sample_jacobian(const camera::CameraIntrinsics& K, const PreparedView& v,
+                                                           const Pose& pose, const Vec3& X, const Vec2& normal) {
+  const Vec3 Xc = v.R_cb * X + v.t_cb;
+  Eigen::Matrix<double, 2, 3> dp;
+  const double h = 1e-6 * Xc.z();
+  for (int a = 0; a < 3; ++a) {
+    Vec3 dx = Vec3::Zero();
+    dx[a] = h;
+    const auto pp = K.project(Xc + dx), pm = K.project(Xc - dx);
+    if (!pp || !pm) return std::nullopt;
+    dp.col(a) = (*pp - *pm) / (2 * h);
+  }
+  Eigen::Matrix<double, 3, 6> dX;
+  dX.leftCols<3>() = -skew(X - pose.t);
+  dX.rightCols<3>() = Mat3::Identity();
+  return Eigen::Matrix<double, 1, 6>(normal.transpose() * dp * v.R_cb * dX);
+}
+
 // The outer contour samples of one view at `level` with their edge measurements; the
 // attachments' outline is measured only `with_attachments` (for score_with_attachments, once).
 void gather(const EdgeMesh& m, const Pose& pose, const PreparedView& v, const camera::CameraIntrinsics& K, int level,
@@ -182,66 +261,22 @@ void gather(const EdgeMesh& m, const Pose& pose, const PreparedView& v, const ca
   std::vector<char> front(m.triangles.size());
   for (std::size_t f = 0; f < m.triangles.size(); ++f)
     front[f] = m.normals[f].dot(centre_antenna - m.vertices[m.triangles[f][0]]) > 0;
-
-  // Mask of the projection (for a closed mesh its front faces alone cover it: every line of sight
-  // into the solid enters through one), edges subdivided so that the distortion's bowing is kept;
-  // over the projection's own box (so that the outer-contour test also works outside the crop,
-  // where samples are counted as unmeasurable), at most ~1000 px.
-  std::vector<std::optional<Vec2>> uv(m.vertices.size());
-  Vec2 lo = Vec2::Constant(1e300), hi = Vec2::Constant(-1e300);
-  for (std::size_t i = 0; i < m.vertices.size(); ++i) {
-    uv[i] = project(K, v, pose.R * m.vertices[i] + pose.t);
-    if (!uv[i]) return;  // part of the model behind the camera
-    lo = lo.cwiseMin(*uv[i]), hi = hi.cwiseMax(*uv[i]);
-  }
-  const double pad = 8 + 0.05 * (hi - lo).maxCoeff();
-  const Vec2 origin = lo - Vec2::Constant(pad);
-  const Vec2 extent = hi - lo + Vec2::Constant(2 * pad);
-  if (!(extent.maxCoeff() < 1e5)) return;  // a degenerate projection (model at the camera)
-  const double ms = std::max(1.0, extent.maxCoeff() / 1000.0);
-  cv::Mat mask = cv::Mat::zeros(static_cast<int>(std::ceil(extent.y() / ms)) + 1,
-                                static_cast<int>(std::ceil(extent.x() / ms)) + 1, CV_8UC1);
-  auto to_mask = [&](const Vec2& p) { return Vec2((p.x() - origin.x()) / ms, (p.y() - origin.y()) / ms); };
-  std::vector<cv::Point> poly;
-  for (std::size_t f = 0; f < m.triangles.size(); ++f) {
-    if (m.closed && !front[f]) continue;
-    const auto& t = m.triangles[f];
-    poly.clear();
-    for (int k = 0; k < 3; ++k) {
-      const Vec3 A = pose.R * m.vertices[t[k]] + pose.t, B = pose.R * m.vertices[t[(k + 1) % 3]] + pose.t;
-      const double len = (*uv[t[(k + 1) % 3]] - *uv[t[k]]).norm() / ms;
-      const int n = std::clamp(static_cast<int>(std::ceil(len / 8.0)), 1, 64);
-      for (int j = 0; j < n; ++j) {
-        const auto p = project(K, v, A + (B - A) * (double(j) / n));
-        if (!p) return;
-        const Vec2 q = to_mask(*p) * 4.0;  // shift = 2: quarter-pixel vertices
-        poly.emplace_back(round_px(q.x()), round_px(q.y()));
-      }
-    }
-    const cv::Point* vertices = poly.data();
-    const int count = static_cast<int>(poly.size());
-    cv::fillPoly(mask, &vertices, &count, 1, cv::Scalar(255), cv::LINE_8, 2);
-  }
-  auto inside = [&](const Vec2& q) {
-    const int x = round_px(q.x()), y = round_px(q.y());
-    return x >= 0 && y >= 0 && x < mask.cols && y < mask.rows && mask.at<std::uint8_t>(y, x) != 0;
-  };
+  const auto projection = project_model(m, pose, v, K, front);
+  if (!projection) return;
+  const ProjectionMask& pm = *projection;
   // The projection's extent behind an outline point (mask px against its outward normal), up to
   // twice the search range: beyond, it does not limit the search.
-  const double max_depth = 2 * search_px * scale / ms + 2;
+  const double max_depth = 2 * search_px * scale / pm.ms + 2;
   auto depth_inside = [&](const Vec2& q, const Vec2& outward) {
     double depth = 1;
-    while (depth < max_depth && inside(q - depth * outward)) depth += 1;
+    while (depth < max_depth && pm.inside(q - depth * outward)) depth += 1;
     return depth;
   };
-
   const Vec3 half_box = o.outline_box_m / 2 + Vec3::Constant(o.box_tolerance_m);
   const bool whole_outline = !(o.outline_box_m.array() > 0).all();
   auto on_box = [&](const Vec3& p_antenna) {
     return whole_outline || (p_antenna.cwiseAbs().array() <= half_box.array()).all();
   };
-  const cv::Mat& gx = v.gx[level];
-  const cv::Mat& gy = v.gy[level];
   std::vector<double> g;
   const double spacing = o.sample_spacing_px * scale;
   for (std::size_t ei = 0; ei < m.edges.size(); ++ei) {
@@ -249,10 +284,9 @@ void gather(const EdgeMesh& m, const Pose& pose, const PreparedView& v, const ca
     bool silhouette = e.faces.size() == 1;
     for (std::size_t i = 1; i < e.faces.size(); ++i) silhouette |= front[e.faces[i]] != front[e.faces[0]];
     if (!silhouette) continue;
-    const Vec2 pa = *uv[e.a], pb = *uv[e.b];
     const Vec3& a_antenna = m.vertices[e.a];
     const Vec3& b_antenna = m.vertices[e.b];
-    const int n = static_cast<int>(std::floor((pb - pa).norm() / spacing));
+    const int n = static_cast<int>(std::floor((*pm.uv[e.b] - *pm.uv[e.a]).norm() / spacing));
     const Vec3 A = pose.R * a_antenna + pose.t, B = pose.R * b_antenna + pose.t;
     for (int j = 0; j < n; ++j) {
       const double s = (j + 0.5) / n, ds = 0.25 / n;
@@ -265,9 +299,8 @@ void gather(const EdgeMesh& m, const Pose& pose, const PreparedView& v, const ca
       if (!p || !p0 || !p1) continue;
       const Vec2 d = (*p1 - *p0).normalized();
       Vec2 normal(-d.y(), d.x());
-      const Vec2 q = to_mask(*p);
-      const double k = 1.5;
-      const bool in_minus = inside(q - k * normal), in_plus = inside(q + k * normal);
+      const Vec2 q = pm.to_mask(*p);
+      const bool in_minus = pm.inside(q - 1.5 * normal), in_plus = pm.inside(q + 1.5 * normal);
       if (in_minus == in_plus) continue;  // inner edge, or hidden by another part of the model
       if (in_plus) normal = -normal;
       if (masked(v, level, *p)) continue;  // hidden, or where a known object's edge would be taken for it
@@ -292,47 +325,27 @@ void gather(const EdgeMesh& m, const Pose& pose, const PreparedView& v, const ca
       // for this side's, or ranking this side's as too weak, it pulls the pose across the panel.
       // (Whether the middle is within reach is noted either way: where it never is, the descent
       // is the same with line_ends_at_middle on or off.)
-      const double middle = 0.5 * depth_inside(q, normal) * ms / scale;
+      const double middle = 0.5 * depth_inside(q, normal) * pm.ms / scale;
       counts.reached_middle = counts.reached_middle || middle < search_px;
       const double behind = o.line_ends_at_middle ? std::min(search_px, middle) : search_px;
-      const auto edge =
-          camera::nearest_edge(gx, gy, (*p - v.offset) / scale, normal, {behind, search_px}, o.min_edge_gradient, g);
+      const auto edge = camera::nearest_edge(v.gx[level], v.gy[level], in_crop / scale, normal, {behind, search_px},
+                                             o.min_edge_gradient, g);
       if (attachment) {
         counts.attachment_cost += edge_cost(edge ? std::optional<double>(*edge * scale) : std::nullopt, o);
         continue;
       }
       if (!edge) continue;
-      Sample smp;
-      smp.normal = normal;
-      smp.r = *edge * scale;
-      // Jacobian of the projection by central differences in the camera frame (distortion included).
-      const Vec3 Xc = v.R_cb * X + v.t_cb;
-      Eigen::Matrix<double, 2, 3> dp;
-      const double h = 1e-6 * Xc.z();
-      bool ok = true;
-      for (int a = 0; a < 3 && ok; ++a) {
-        Vec3 dx = Vec3::Zero();
-        dx[a] = h;
-        const auto pp = K.project(Xc + dx), pm = K.project(Xc - dx);
-        if (!pp || !pm)
-          ok = false;
-        else
-          dp.col(a) = (*pp - *pm) / (2 * h);
-      }
-      if (!ok) continue;
-      Eigen::Matrix<double, 3, 6> dX;
-      dX.leftCols<3>() = -skew(X - pose.t);
-      dX.rightCols<3>() = Mat3::Identity();
-      smp.J = normal.transpose() * dp * v.R_cb * dX;
-      smp.edge = static_cast<std::uint32_t>(ei);
-      smp.px_per_m = 0.5 * (K.fx + K.fy) / Xc.z();
-      out.push_back(smp);
+      const auto J = sample_jacobian(K, v, pose, X, normal);
+      if (!J) continue;
+      const double depth = (v.R_cb * X + v.t_cb).z();
+      out.push_back({normal, *edge * scale, *J, static_cast<std::uint32_t>(ei), 0.5 * (K.fx + K.fy) / depth});
     }
   }
 }
 
 struct Gathered {
   std::vector<std::vector<Sample>> per_view;
+  std::vector<OutlineCounts> per_view_counts;
   OutlineCounts counts;
   std::size_t views_with_samples = 0;
 };
@@ -342,7 +355,8 @@ Gathered gather_all(const EdgeMesh& m, const Pose& pose, const std::vector<Prepa
                     bool with_attachments = false) {
   Gathered g;
   g.per_view.resize(views.size());
-  std::vector<OutlineCounts> counts(views.size());
+  auto& counts = g.per_view_counts;
+  counts.resize(views.size());
   cv::parallel_for_(cv::Range(0, static_cast<int>(views.size())), [&](const cv::Range& r) {
     for (int i = r.start; i < r.end; ++i)
       gather(m, pose, views[i], K, level, search_px, o, with_attachments, g.per_view[i], counts[i]);
@@ -352,6 +366,87 @@ Gathered gather_all(const EdgeMesh& m, const Pose& pose, const std::vector<Prepa
     g.views_with_samples += g.per_view[i].empty() ? 0 : 1;
   }
   return g;
+}
+
+// The photos prepared for the outline of the model at `pose`: each cropped (its ROI, or the
+// model's projected box plus a margin), as gradient pyramids in linear intensity (edges are
+// located there: in encoded values the outline's width, and so the yaw, would be biased), masked
+// where known objects are. `top`: the coarsest level, where the model's narrowest projection is
+// still min_coarse_width_px wide (at most `max_level`).
+struct PreparedViews {
+  std::vector<PreparedView> views;
+  int top = 0;
+};
+
+PreparedViews prepare_views(const EdgeMesh& m, const Pose& pose, const std::vector<SilhouetteView>& views,
+                            const camera::CameraIntrinsics& intrinsics, const SilhouetteOptions& options, int max_level,
+                            std::vector<std::string>& warnings) {
+  PreparedViews out;
+  auto& prepared = out.views;
+  prepared.resize(views.size());
+  double narrowest = 1e300;
+  for (std::size_t i = 0; i < views.size(); ++i) {
+    const auto& in = views[i];
+    if (in.image.type() != CV_8UC1 || in.image.cols != intrinsics.width || in.image.rows != intrinsics.height)
+      throw std::invalid_argument(fmt::format("refine_by_silhouette: view {} is not a CV_8UC1 image of {}x{} px", i,
+                                              intrinsics.width, intrinsics.height));
+    auto& v = prepared[i];
+    v.R_cb = in.R_camera_board;
+    v.t_cb = in.t_camera_board;
+    const auto box = projected_box(intrinsics, v, m, pose);
+    if (!box) {
+      warnings.push_back(fmt::format("view {}: the model lies (partly) behind the camera; skipped", i));
+      continue;
+    }
+    cv::Rect crop;
+    if (in.roi) {
+      crop = *in.roi;
+    } else {
+      const double margin = options.roi_margin_px + 0.1 * std::max(box->width, box->height);
+      crop = cv::Rect(static_cast<int>(std::floor(box->x - margin)), static_cast<int>(std::floor(box->y - margin)),
+                      static_cast<int>(std::ceil(box->width + 2 * margin)),
+                      static_cast<int>(std::ceil(box->height + 2 * margin)));
+    }
+    crop &= cv::Rect(0, 0, in.image.cols, in.image.rows);
+    if (crop.width < 16 || crop.height < 16) {
+      warnings.push_back(fmt::format("view {}: the antenna's region lies outside the photo; skipped", i));
+      continue;
+    }
+    v.usable = true;
+    v.offset = Vec2(crop.x, crop.y);
+    v.size = crop.size();
+    narrowest = std::min(narrowest, std::min(box->width, box->height));
+  }
+  if (narrowest < 1e300)
+    out.top =
+        std::clamp(static_cast<int>(std::floor(std::log2(std::max(1.0, narrowest / options.min_coarse_width_px)))), 0,
+                   std::max(0, max_level));
+  cv::parallel_for_(cv::Range(0, static_cast<int>(views.size())), [&](const cv::Range& r) {
+    for (int i = r.start; i < r.end; ++i) {
+      auto& v = prepared[i];
+      if (!v.usable) continue;
+      const cv::Mat crop = views[i].image(
+          cv::Rect(static_cast<int>(v.offset.x()), static_cast<int>(v.offset.y()), v.size.width, v.size.height));
+      cv::Mat level = camera::linear_intensity(crop, options.gamma);
+      const bool with_mask = !views[i].occluders.empty() || !views[i].background_edges.empty();
+      for (int l = 0; l <= out.top; ++l) {
+        if (l > 0) {
+          cv::Mat down;
+          cv::pyrDown(level, down);
+          level = down;
+        }
+        auto [gx, gy] = camera::smoothed_gradients(level, options.smoothing_sigma_px);
+        if (with_mask) {
+          v.mask.push_back(level_mask(views[i], v.offset, level.size(), l, options.mask_guard_px));
+          gx.setTo(0, v.mask.back());
+          gy.setTo(0, v.mask.back());
+        }
+        v.gx.push_back(gx);
+        v.gy.push_back(gy);
+      }
+    }
+  });
+  return out;
 }
 
 // Tukey weights with the scale from the median absolute residual (in the level's px).
@@ -459,6 +554,186 @@ struct Descent {
   double score = 1.0;
 };
 
+// The descents of one refinement: its prepared photos, stages (level, search in that level's px:
+// the coarsest searches wide, every later one ±fine_search_px; a monotone descent also ends on a
+// fine stage where the model is too narrow for a pyramid, on the edges the score and the
+// covariance use — a narrow panel's own, not the mast's 20 px beyond it) and options.
+class Descender {
+ public:
+  Descender(const EdgeMesh& m, const PreparedViews& ready, const camera::CameraIntrinsics& K,
+            const SilhouetteOptions& o, const std::optional<RotationPrior>& prior)
+      : m_(m), views_(ready.views), K_(K), o_(o), prior_(prior) {
+    for (int level = ready.top; level >= 0; --level)
+      stages_.emplace_back(level, level == ready.top
+                                      ? std::max(o.fine_search_px, o.search_range_px / std::ldexp(1.0, level))
+                                      : o.fine_search_px);
+    if (monotone() && stages_.back().second > o.fine_search_px) stages_.emplace_back(0, o.fine_search_px);
+  }
+
+  Gathered gather(const Pose& p, int level, double search_px, bool with_attachments = false) {
+    Gathered g = gather_all(m_, p, views_, K_, level, search_px, o_, with_attachments);
+    reached_middle_ = reached_middle_ || g.counts.reached_middle;
+    return g;
+  }
+  double full_score(const Pose& p) { return score(gather(p, 0, o_.fine_search_px), o_); }
+  bool reached_middle() const { return reached_middle_; }
+
+  Descent descend(const Pose& start) {
+    Descent d;
+    d.pose = start;
+    for (const auto& [level, search] : stages_) descend_stage(d, level, search);
+    d.score = full_score(d.pose);
+    return d;
+  }
+
+ private:
+  bool monotone() const { return o_.max_step_halvings >= 0; }
+
+  void descend_stage(Descent& d, int level, double search) {
+    const double scale = std::ldexp(1.0, level);
+    // Monotone at full resolution: Gauss–Newton re-associates the edges at every step, and nearer
+    // a strong clutter edge than the panel's own it walks off the outline while each step looks
+    // good to its own linearisation; the score (which ranks the starts) does not.
+    const bool checked = monotone() && level == 0;
+    double current = checked ? full_score(d.pose) : 0.0;
+    d.converged = false;
+    Vec6 previous_step = Vec6::Zero();
+    for (int it = 0; it < o_.max_iterations_per_level; ++it) {
+      const Gathered g = gather(d.pose, level, search);
+      Normal n = normal_equations(g, scale, o_);
+      if (n.inliers < 12) break;
+      add_prior(n, d.pose.R, prior_, o_);
+      auto delta = solve(n, o_.free);
+      if (!delta) break;
+      ++d.iterations;
+      // The step's weighted RMS image motion, in the level's px.
+      const double motion = std::sqrt(std::max(0.0, delta->dot(n.H * *delta)) / n.sum_w) / scale;
+      // A trust region on the rotation: where the outline hardly fixes the yaw (a narrow panel on
+      // a coarse level, seen face-on from below) the step about the long axis can be 100°+, far
+      // beyond the linearisation, and the descent wanders from basin to basin.
+      if (const double turn = delta->head<3>().norm(); turn > o_.max_step_rotation_rad)
+        *delta *= o_.max_step_rotation_rad / turn;
+      // Where the outline hardly fixes a direction (the yaw of a narrow panel seen face-on),
+      // samples entering and leaving the robust weights make the steps swing back and forth about
+      // the minimum without shrinking: a small step reversing the last one has arrived, and half
+      // of it lands between the two poses.
+      const bool swinging = motion < o_.swing_motion_px && delta->dot(n.H * previous_step) < 0.0;
+      if (swinging) *delta /= 2;
+      if (checked && !lowers_score(d, *delta, current)) {  // nothing along Gauss–Newton's direction does: arrived
+        d.converged = true;
+        return;
+      }
+      d.pose.R = exp_so3(delta->head<3>()) * d.pose.R;
+      d.pose.t += delta->tail<3>();
+      previous_step = *delta;
+      if (motion < 0.01 || swinging) {
+        d.converged = true;
+        return;
+      }
+    }
+  }
+
+  // The step, halved up to max_step_halvings times until it lowers the score (a line search).
+  bool lowers_score(const Descent& d, Vec6& delta, double& current) {
+    for (int halving = 0; halving <= o_.max_step_halvings; ++halving) {
+      const double trial = full_score(Pose{exp_so3(delta.head<3>()) * d.pose.R, d.pose.t + delta.tail<3>()});
+      if (trial <= current) {
+        current = trial;
+        return true;
+      }
+      delta /= 2;
+    }
+    return false;
+  }
+
+  const EdgeMesh& m_;
+  const std::vector<PreparedView>& views_;
+  const camera::CameraIntrinsics& K_;
+  const SilhouetteOptions& o_;
+  const std::optional<RotationPrior>& prior_;
+  std::vector<std::pair<int, double>> stages_;
+  bool reached_middle_ = false;  // by any search line of any evaluation
+};
+
+// The covariance at the solution (file comment): the sandwich H⁻¹ (Σ_white + Σ_bias) H⁻¹ of white
+// edge noise (inflated for the samples' overlap), errors shared by all samples of a mesh edge (the
+// model's shape tolerance, the same in every view; an edge-localisation bias per view and edge:
+// background, blur, shading) and that bias common to the whole outline (a dilation). The prior
+// counts once as information (in H) and once as its own noise (in M).
+void covariance_at(SilhouetteResult& result, const Gathered& g, const Normal& n, const Mat6& Hinv, double prior_weight,
+                   const std::optional<RotationPrior>& prior, const EdgeMesh& m, const Pose& pose,
+                   const SilhouetteOptions& o) {
+  result.rms_px = std::sqrt(n.sum_wr2 / n.sum_w);
+  const double sigma2 = n.sum_wr2 / std::max(1.0, n.sum_w - 6.0);
+  const double inflation = std::max(1.0, o.correlation_length_px / o.sample_spacing_px);
+  Mat6 M = sigma2 * inflation * n.H;
+  if (prior)
+    M.topLeftCorner<3, 3>() += (prior_weight * prior_weight - sigma2 * inflation * prior_weight) * prior->information;
+  std::vector<Vec6> shape(m.edges.size(), Vec6::Zero()), bias(m.edges.size(), Vec6::Zero());
+  Vec6 dilation = Vec6::Zero();
+  for (const auto& view : g.per_view)
+    for (const auto& s : view) {
+      const double w = n.weight(s.r);
+      if (w <= 0) continue;
+      shape[s.edge] += w * s.px_per_m * o.shape_tolerance_m * s.J.transpose();
+      bias[s.edge] += w * o.edge_bias_px * s.J.transpose();
+      dilation += w * o.outline_dilation_px * s.J.transpose();
+    }
+  for (std::size_t e = 0; e < m.edges.size(); ++e) M += shape[e] * shape[e].transpose() + bias[e] * bias[e].transpose();
+  M += dilation * dilation.transpose();
+  result.covariance = Hinv * M * Hinv;
+  result.dilation_yaw_sigma_rad = std::abs((Hinv * dilation).head<3>().dot(pose.R.col(2)));
+}
+
+// The checks of the result (SilhouetteOptions' acceptance), each failure a warning; whether it
+// passed them all but the iteration limit, which is judged last: alone, it leaves a descent a
+// search may continue.
+bool passes_checks(SilhouetteResult& result, bool solvable, const OutlineCounts& counts, const Descent& best,
+                   const std::optional<Descent>& rival, const Pose& start, const SilhouetteOptions& o) {
+  bool ok = solvable;
+  auto fail = [&](std::string why) { ok = false, result.warnings.push_back(std::move(why)); };
+  if (!solvable)
+    result.warnings.push_back("silhouette: too few contour samples found an edge to fix the pose");
+  else if (!best.converged)
+    result.warnings.push_back(
+        fmt::format("silhouette: no convergence within {} iterations at full resolution", o.max_iterations_per_level));
+  const double outside = counts.candidates ? double(counts.outside) / double(counts.candidates) : 0.0;
+  if (outside > o.max_outside_fraction)
+    fail(
+        fmt::format("silhouette: {:.0f} % of the model's outline falls outside the photos or their regions of interest",
+                    100 * outside));
+  if (static_cast<int>(result.views_used) < o.min_views)
+    fail(fmt::format("silhouette: only {} view(s) show the model's outline (at least {} needed)", result.views_used,
+                     o.min_views));
+  if (result.inlier_fraction < o.min_inlier_fraction)
+    fail(
+        fmt::format("silhouette: only {:.0f} % of the model's outline meets an image edge (at least {:.0f} % "
+                    "expected); is the antenna in the photos and the start close?",
+                    100 * result.inlier_fraction, 100 * o.min_inlier_fraction));
+  if (solvable && result.rms_px > o.max_rms_px)
+    fail(fmt::format("silhouette: edge RMS {:.2f} px (more than {:.2f} px)", result.rms_px, o.max_rms_px));
+  if (rival && rival->score < best.score) {
+    result.left_start = rival->pose.T();
+    fail(
+        fmt::format("silhouette: a pose turned {:.1f}° from the result fits the outline better (score {:.3f} vs "
+                    "{:.3f}) but lies more than {:.0f}° from the start: the start is probably wrong",
+                    rad2deg(result.rival_rotation_rad), rival->score, best.score, rad2deg(o.max_rotation_change_rad)));
+  } else if (rival && rival->score < best.score + o.rival_margin) {
+    fail(
+        fmt::format("silhouette: ambiguous yaw: a pose turned {:.1f}° fits the outline nearly as well (score {:.3f} "
+                    "vs {:.3f}); photograph the antenna over a wider arc",
+                    rad2deg(result.rival_rotation_rad), rival->score, best.score));
+  }
+  if (const double turned = rotation_distance(start.R, best.pose.R); turned > o.max_rotation_change_rad) {
+    if (!result.left_start) result.left_start = result.T_board_antenna;
+    fail(
+        fmt::format("silhouette: the pose turned {:.1f}° from the start (more than {:.1f}°): probably another local "
+                    "minimum",
+                    rad2deg(turned), rad2deg(o.max_rotation_change_rad)));
+  }
+  return ok;
+}
+
 }  // namespace
 
 SilhouetteResult refine_by_silhouette(const model::Mesh& mesh_antenna, const Iso3& T_board_antenna_initial,
@@ -469,172 +744,24 @@ SilhouetteResult refine_by_silhouette(const model::Mesh& mesh_antenna, const Iso
   const EdgeMesh m = weld(mesh_antenna);
   SilhouetteResult result;
   result.T_board_antenna = T_board_antenna_initial;
-  Pose pose{T_board_antenna_initial.linear(), T_board_antenna_initial.translation()};
-  const Pose start = pose;
+  const Pose start{T_board_antenna_initial.linear(), T_board_antenna_initial.translation()};
+  const PreparedViews ready = prepare_views(m, start, views, intrinsics, options, options.max_level, result.warnings);
+  Descender descender(m, ready, intrinsics, options, prior);
 
-  // Crops and the coarsest level: the model's narrowest projection stays min_coarse_width_px wide.
-  std::vector<PreparedView> prepared(views.size());
-  double narrowest = 1e300;
-  for (std::size_t i = 0; i < views.size(); ++i) {
-    const auto& in = views[i];
-    if (in.image.type() != CV_8UC1 || in.image.cols != intrinsics.width || in.image.rows != intrinsics.height)
-      throw std::invalid_argument(fmt::format("refine_by_silhouette: view {} is not a CV_8UC1 image of {}x{} px", i,
-                                              intrinsics.width, intrinsics.height));
-    auto& v = prepared[i];
-    v.R_cb = in.R_camera_board;
-    v.t_cb = in.t_camera_board;
-    const auto box = projected_box(intrinsics, v, m, pose);
-    if (!box) {
-      result.warnings.push_back(fmt::format("view {}: the model lies (partly) behind the camera; skipped", i));
-      continue;
-    }
-    cv::Rect crop;
-    if (in.roi) {
-      crop = *in.roi;
-    } else {
-      const double margin = options.roi_margin_px + 0.1 * std::max(box->width, box->height);
-      crop = cv::Rect(static_cast<int>(std::floor(box->x - margin)), static_cast<int>(std::floor(box->y - margin)),
-                      static_cast<int>(std::ceil(box->width + 2 * margin)),
-                      static_cast<int>(std::ceil(box->height + 2 * margin)));
-    }
-    crop &= cv::Rect(0, 0, in.image.cols, in.image.rows);
-    if (crop.width < 16 || crop.height < 16) {
-      result.warnings.push_back(fmt::format("view {}: the antenna's region lies outside the photo; skipped", i));
-      continue;
-    }
-    v.usable = true;
-    v.offset = Vec2(crop.x, crop.y);
-    v.size = crop.size();
-    narrowest = std::min(narrowest, std::min(box->width, box->height));
-  }
-  int top = 0;
-  if (narrowest < 1e300)
-    top = std::clamp(static_cast<int>(std::floor(std::log2(std::max(1.0, narrowest / options.min_coarse_width_px)))), 0,
-                     std::max(0, options.max_level));
-  cv::parallel_for_(cv::Range(0, static_cast<int>(views.size())), [&](const cv::Range& r) {
-    for (int i = r.start; i < r.end; ++i) {
-      auto& v = prepared[i];
-      if (!v.usable) continue;
-      const cv::Mat crop = views[i].image(
-          cv::Rect(static_cast<int>(v.offset.x()), static_cast<int>(v.offset.y()), v.size.width, v.size.height));
-      // Edges are located in linear intensity (camera/edge_search.hpp): in encoded values the
-      // outline's width, and so the yaw, would be biased.
-      cv::Mat level = camera::linear_intensity(crop, options.gamma);
-      const bool with_mask = !views[i].occluders.empty() || !views[i].background_edges.empty();
-      for (int l = 0; l <= top; ++l) {
-        if (l > 0) {
-          cv::Mat down;
-          cv::pyrDown(level, down);
-          level = down;
-        }
-        auto [gx, gy] = camera::smoothed_gradients(level, options.smoothing_sigma_px);
-        if (with_mask) {
-          v.mask.push_back(level_mask(views[i], v.offset, level.size(), l, options.mask_guard_px));
-          gx.setTo(0, v.mask.back());
-          gy.setTo(0, v.mask.back());
-        }
-        v.gx.push_back(gx);
-        v.gy.push_back(gy);
-      }
-    }
-  });
-
-  bool reached_middle = false;  // by any search line of any evaluation below
-  const auto gather_here = [&](const Pose& p, int level, double search_px, bool with_attachments = false) {
-    Gathered g = gather_all(m, p, prepared, intrinsics, level, search_px, options, with_attachments);
-    reached_middle = reached_middle || g.counts.reached_middle;
-    return g;
-  };
-  const auto full_score = [&](const Pose& p) { return score(gather_here(p, 0, options.fine_search_px), options); };
-  // Stages (level, search in that level's px): the coarsest searches wide, every later one
-  // ±fine_search_px. A monotone descent also ends on a fine stage where the model is too narrow for
-  // a pyramid, on the edges the score and the covariance use (a narrow panel's own, not the
-  // mast's 20 px beyond it).
-  const bool monotone = options.max_step_halvings >= 0;
-  std::vector<std::pair<int, double>> stages;
-  for (int level = top; level >= 0; --level)
-    stages.emplace_back(level, level == top
-                                   ? std::max(options.fine_search_px, options.search_range_px / std::ldexp(1.0, level))
-                                   : options.fine_search_px);
-  if (monotone && stages.back().second > options.fine_search_px) stages.emplace_back(0, options.fine_search_px);
-
-  const auto descend = [&](Pose p) {
-    Descent d;
-    d.pose = p;
-    for (const auto& [level, search] : stages) {
-      const double scale = std::ldexp(1.0, level);
-      // Monotone at full resolution: Gauss–Newton re-associates the edges at every step, and
-      // nearer a strong clutter edge than the panel's own it walks off the outline while each
-      // step looks good to its own linearisation; the score (which ranks the starts) does not.
-      const bool checked = monotone && level == 0;
-      double current = checked ? full_score(d.pose) : 0.0;
-      d.converged = false;
-      Vec6 previous_step = Vec6::Zero();
-      for (int it = 0; it < options.max_iterations_per_level; ++it) {
-        const Gathered g = gather_here(d.pose, level, search);
-        Normal n = normal_equations(g, scale, options);
-        if (n.inliers < 12) break;
-        add_prior(n, d.pose.R, prior, options);
-        auto delta = solve(n, options.free);
-        if (!delta) break;
-        ++d.iterations;
-        // The step's weighted RMS image motion, in the level's px.
-        const double motion = std::sqrt(std::max(0.0, delta->dot(n.H * *delta)) / n.sum_w) / scale;
-        // A trust region on the rotation: where the outline hardly fixes the yaw (a narrow
-        // panel on a coarse level, seen face-on from below) the step about the long axis can be
-        // 100°+, far beyond the linearisation, and the descent wanders from basin to basin.
-        if (const double turn = delta->head<3>().norm(); turn > options.max_step_rotation_rad)
-          *delta *= options.max_step_rotation_rad / turn;
-        // Where the outline hardly fixes a direction (the yaw of a narrow panel seen face-on),
-        // samples entering and leaving the robust weights make the steps swing back and forth
-        // about the minimum without shrinking: a small step reversing the last one has arrived,
-        // and half of it lands between the two poses.
-        const bool swinging = motion < options.swing_motion_px && delta->dot(n.H * previous_step) < 0.0;
-        if (swinging) *delta /= 2;
-        if (checked) {
-          bool taken = false;
-          for (int halving = 0; halving <= options.max_step_halvings && !taken; ++halving) {
-            const double trial = full_score(Pose{exp_so3(delta->head<3>()) * d.pose.R, d.pose.t + delta->tail<3>()});
-            if (trial <= current)
-              taken = true, current = trial;
-            else
-              *delta /= 2;
-          }
-          if (!taken) {  // no step along Gauss–Newton's direction lowers the score: arrived
-            d.converged = true;
-            break;
-          }
-        }
-        d.pose.R = exp_so3(delta->head<3>()) * d.pose.R;
-        d.pose.t += delta->tail<3>();
-        previous_step = *delta;
-        if (motion < 0.01 || swinging) {
-          d.converged = true;
-          break;
-        }
-      }
-    }
-    d.score = full_score(d.pose);
-    return d;
-  };
-
-  Descent best = descend(pose);
+  Descent best = descender.descend(start);
   result.iterations = best.iterations;
   // A panel's outline is nearly the same at two yaws (the width w|cos θ| + d|sin θ| repeats
   // about θ = atan(d/w)) when the views span little: descend again from starts turned about the
   // long axis and keep the best score; a distinct rival that scores nearly as well is reported.
   std::optional<Descent> rival;
   for (const double offset : options.rival_yaw_offsets_rad) {
-    const Vec3 axis = best.pose.R.col(2);
-    Descent d = descend(Pose{exp_so3(offset * axis) * best.pose.R, best.pose.t});
+    Descent d = descender.descend(Pose{exp_so3(offset * best.pose.R.col(2)) * best.pose.R, best.pose.t});
     result.iterations += d.iterations;
     if (rotation_distance(d.pose.R, best.pose.R) < deg2rad(2.0)) continue;
     if (d.score < best.score && rotation_distance(d.pose.R, start.R) <= options.max_rotation_change_rad)
       std::swap(d, best);
     if (!rival || d.score < rival->score) rival = d;
   }
-  pose = best.pose;
-  const bool last_level_converged = best.converged;
   result.score = best.score;
   if (rival) {
     result.rival_score = rival->score;
@@ -642,103 +769,45 @@ SilhouetteResult refine_by_silhouette(const model::Mesh& mesh_antenna, const Iso
   }
 
   // Statistics and covariance at the solution (full resolution, fine search).
-  const Gathered g = gather_here(pose, 0, options.fine_search_px, true);
-  result.search_reached_middle = reached_middle;
+  const Gathered g = descender.gather(best.pose, 0, options.fine_search_px, true);
+  result.search_reached_middle = descender.reached_middle();
   result.score_with_attachments = score(g, options, true);
   Normal n = normal_equations(g, 1.0, options);
-  const double prior_weight = n.inliers > 12 ? add_prior(n, pose.R, prior, options) : 0.0;
-  result.T_board_antenna = pose.T();
+  const double prior_weight = n.inliers > 12 ? add_prior(n, best.pose.R, prior, options) : 0.0;
+  result.T_board_antenna = best.pose.T();
   result.views_used = g.views_with_samples;
   result.samples = n.inliers;
   result.inlier_fraction = g.counts.candidates ? double(n.inliers) / double(g.counts.candidates) : 0.0;
   Mat6 Hinv;
   const bool solvable = n.inliers > 12 && solve(n, options.free, &Hinv).has_value();
-  if (solvable) {
-    result.rms_px = std::sqrt(n.sum_wr2 / n.sum_w);
-    const double dof = std::max(1.0, n.sum_w - 6.0);
-    const double sigma2 = n.sum_wr2 / dof;
-    const double inflation = std::max(1.0, options.correlation_length_px / options.sample_spacing_px);
-    // Sandwich H⁻¹ (Σ_white + Σ_bias) H⁻¹: white edge noise (inflated for the samples' overlap),
-    // plus errors shared by all samples of a mesh edge: the model's shape tolerance (the same in
-    // every view) and an edge-localisation bias per view and edge (background, blur, shading),
-    // plus that bias common to the whole outline (a dilation, see the header).
-    // The prior counts once as information (in H) and once as its own noise (in M).
-    Mat6 M = sigma2 * inflation * n.H;
-    if (prior)
-      M.topLeftCorner<3, 3>() += (prior_weight * prior_weight - sigma2 * inflation * prior_weight) * prior->information;
-    std::vector<Vec6> shape(m.edges.size(), Vec6::Zero()), bias(m.edges.size(), Vec6::Zero());
-    Vec6 dilation = Vec6::Zero();
-    for (const auto& view : g.per_view)
-      for (const auto& s : view) {
-        const double w = n.weight(s.r);
-        if (w <= 0) continue;
-        shape[s.edge] += w * s.px_per_m * options.shape_tolerance_m * s.J.transpose();
-        bias[s.edge] += w * options.edge_bias_px * s.J.transpose();
-        dilation += w * options.outline_dilation_px * s.J.transpose();
-      }
-    for (std::size_t e = 0; e < m.edges.size(); ++e)
-      M += shape[e] * shape[e].transpose() + bias[e] * bias[e].transpose();
-    M += dilation * dilation.transpose();
-    result.covariance = Hinv * M * Hinv;
-    result.dilation_yaw_sigma_rad = std::abs((Hinv * dilation).head<3>().dot(pose.R.col(2)));
-  }
-
-  // The iteration limit is judged last: alone, it leaves a descent a search may continue.
-  bool ok = solvable;
-  if (!solvable)
-    result.warnings.push_back("silhouette: too few contour samples found an edge to fix the pose");
-  else if (!last_level_converged)
-    result.warnings.push_back(fmt::format("silhouette: no convergence within {} iterations at full resolution",
-                                          options.max_iterations_per_level));
-  const double outside = g.counts.candidates ? double(g.counts.outside) / double(g.counts.candidates) : 0.0;
-  if (outside > options.max_outside_fraction) {
-    ok = false;
-    result.warnings.push_back(
-        fmt::format("silhouette: {:.0f} % of the model's outline falls outside the photos or their regions of interest",
-                    100 * outside));
-  }
-  if (static_cast<int>(result.views_used) < options.min_views) {
-    ok = false;
-    result.warnings.push_back(fmt::format("silhouette: only {} view(s) show the model's outline (at least {} needed)",
-                                          result.views_used, options.min_views));
-  }
-  if (result.inlier_fraction < options.min_inlier_fraction) {
-    ok = false;
-    result.warnings.push_back(fmt::format(
-        "silhouette: only {:.0f} % of the model's outline meets an image edge (at least {:.0f} % expected); is the "
-        "antenna in the photos and the start close?",
-        100 * result.inlier_fraction, 100 * options.min_inlier_fraction));
-  }
-  if (solvable && result.rms_px > options.max_rms_px) {
-    ok = false;
-    result.warnings.push_back(
-        fmt::format("silhouette: edge RMS {:.2f} px (more than {:.2f} px)", result.rms_px, options.max_rms_px));
-  }
-  if (rival && rival->score < best.score) {
-    ok = false;
-    result.left_start = rival->pose.T();
-    result.warnings.push_back(fmt::format(
-        "silhouette: a pose turned {:.1f}° from the result fits the outline better (score {:.3f} vs {:.3f}) but lies "
-        "more than {:.0f}° from the start: the start is probably wrong",
-        rad2deg(result.rival_rotation_rad), rival->score, best.score, rad2deg(options.max_rotation_change_rad)));
-  } else if (rival && rival->score < best.score + options.rival_margin) {
-    ok = false;
-    result.warnings.push_back(fmt::format(
-        "silhouette: ambiguous yaw: a pose turned {:.1f}° fits the outline nearly as well (score {:.3f} vs {:.3f}); "
-        "photograph the antenna over a wider arc",
-        rad2deg(result.rival_rotation_rad), rival->score, best.score));
-  }
-  const double turned = rotation_distance(start.R, pose.R);
-  if (turned > options.max_rotation_change_rad) {
-    ok = false;
-    if (!result.left_start) result.left_start = result.T_board_antenna;
-    result.warnings.push_back(fmt::format(
-        "silhouette: the pose turned {:.1f}° from the start (more than {:.1f}°): probably another local minimum",
-        rad2deg(turned), rad2deg(options.max_rotation_change_rad)));
-  }
-  result.stopped_at_iteration_limit = ok && !last_level_converged;
-  result.converged = ok && last_level_converged;
+  if (solvable) covariance_at(result, g, n, Hinv, prior_weight, prior, m, best.pose, options);
+  const bool ok = passes_checks(result, solvable, g.counts, best, rival, start, options);
+  result.stopped_at_iteration_limit = ok && !best.converged;
+  result.converged = ok && best.converged;
   return result;
+}
+
+OutlineEvaluation evaluate_outline(const model::Mesh& mesh_antenna, const Iso3& T_board_antenna,
+                                   const std::vector<SilhouetteView>& views, const camera::CameraIntrinsics& intrinsics,
+                                   const SilhouetteOptions& options) {
+  if (mesh_antenna.triangles.empty()) throw std::invalid_argument("evaluate_outline: the mesh has no triangles");
+  const EdgeMesh m = weld(mesh_antenna);
+  const Pose pose{T_board_antenna.linear(), T_board_antenna.translation()};
+  OutlineEvaluation out;
+  std::vector<std::string> warnings;
+  const PreparedViews ready = prepare_views(m, pose, views, intrinsics, options, 0, warnings);
+  const Gathered g = gather_all(m, pose, ready.views, intrinsics, 0, options.fine_search_px, options);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (std::size_t i = 0; i < views.size(); ++i) {
+    const OutlineCounts& c = g.per_view_counts[i];
+    double sum = 0.0;
+    for (const auto& smp : g.per_view[i]) sum += edge_cost(smp.r, options);
+    const double unfound = static_cast<double>(c.candidates - g.per_view[i].size());
+    out.cost.push_back(c.candidates ? (sum + unfound) / static_cast<double>(c.candidates) : nan);
+    out.samples.push_back(c.candidates);
+  }
+  out.score = score(g, options);
+  return out;
 }
 
 }  // namespace antpose::registration

@@ -44,7 +44,7 @@
 // sample of every edge with s_i = outline_dilation_px, is the whole outline found wider (or
 // narrower) than the model's by the same amount everywhere: blur and the shading of the rounded
 // long edges do that in every photo alike, and for a narrow panel seen face-on only the yaw can
-// widen the outline, so a dilation of a fraction of a pixel reads as degrees of yaw (5910-2).
+// widen the outline, so a dilation of a fraction of a pixel reads as degrees of yaw.
 #pragma once
 
 #include <array>
@@ -175,5 +175,20 @@ SilhouetteResult refine_by_silhouette(const model::Mesh& mesh_antenna, const Iso
                                       const std::vector<SilhouetteView>& views,
                                       const camera::CameraIntrinsics& intrinsics, const SilhouetteOptions& options,
                                       const std::optional<RotationPrior>& prior = std::nullopt);
+
+/// The outline's fit at one pose, photo by photo, without a descent: what the registration's
+/// selection compares between poses (registration/pose_evidence.hpp). Costs as
+/// SilhouetteResult::score (the mean truncated edge cost, 0 .. 1) over each photo's samples at
+/// full resolution with the fine search; NaN where a photo shows none of that outline (hidden,
+/// out of view), of the box's outline (options.outline_box_m).
+struct OutlineEvaluation {
+  std::vector<double> cost;          // per view
+  std::vector<std::size_t> samples;  // per view: its samples (measured or not)
+  double score = 1;                  // over all views, as SilhouetteResult's
+};
+
+OutlineEvaluation evaluate_outline(const model::Mesh& mesh_antenna, const Iso3& T_board_antenna,
+                                   const std::vector<SilhouetteView>& views, const camera::CameraIntrinsics& intrinsics,
+                                   const SilhouetteOptions& options);
 
 }  // namespace antpose::registration

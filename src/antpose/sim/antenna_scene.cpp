@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <stdexcept>
 
@@ -10,43 +11,12 @@
 
 #include "antpose/core/error.hpp"
 #include "antpose/sim/board_texture.hpp"
+#include "antpose/sim/procedural_noise.hpp"
 #include "antpose/sim/random.hpp"
 
 namespace antpose::sim {
 
 namespace {
-
-// --- procedural noise (value noise on an integer lattice, hashed: no tables, thread-safe) ---
-
-std::uint64_t mix(std::uint64_t x) {
-  // splitmix64 finaliser
-  x += 0x9e3779b97f4a7c15ULL;
-  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
-  return x ^ (x >> 31);
-}
-
-double lattice(std::int64_t i, std::int64_t j, std::int64_t k, std::uint64_t seed) {
-  const std::uint64_t h = mix(seed ^ mix(static_cast<std::uint64_t>(i) ^
-                                         mix(static_cast<std::uint64_t>(j) ^ mix(static_cast<std::uint64_t>(k)))));
-  return static_cast<double>(h >> 11) * (2.0 / 9007199254740992.0) - 1.0;  // [-1, 1)
-}
-
-// Smooth value noise in [-1, 1] with unit lattice spacing.
-double value_noise(const Vec3& p, std::uint64_t seed) {
-  const double fx = std::floor(p.x()), fy = std::floor(p.y()), fz = std::floor(p.z());
-  const auto i = static_cast<std::int64_t>(fx), j = static_cast<std::int64_t>(fy), k = static_cast<std::int64_t>(fz);
-  auto smooth = [](double t) { return t * t * (3.0 - 2.0 * t); };
-  const double ax = smooth(p.x() - fx), ay = smooth(p.y() - fy), az = smooth(p.z() - fz);
-  double c[2][2][2];
-  for (int a = 0; a < 2; ++a)
-    for (int b = 0; b < 2; ++b)
-      for (int d = 0; d < 2; ++d) c[a][b][d] = lattice(i + a, j + b, k + d, seed);
-  auto lerp = [](double u, double v, double t) { return u + t * (v - u); };
-  const double x00 = lerp(c[0][0][0], c[1][0][0], ax), x10 = lerp(c[0][1][0], c[1][1][0], ax);
-  const double x01 = lerp(c[0][0][1], c[1][0][1], ax), x11 = lerp(c[0][1][1], c[1][1][1], ax);
-  return lerp(lerp(x00, x10, ay), lerp(x01, x11, ay), az);
-}
 
 Mat3 rot_antenna(double azimuth, double downtilt, double roll) {
   return rot_z(-azimuth) * rot_x(-downtilt) * rot_y(roll);
@@ -57,7 +27,18 @@ constexpr double kRadomeAlbedo = 0.72, kSteelAlbedo = 0.42;
 }  // namespace
 
 std::string to_string(AntennaSetting s) { return s == AntennaSetting::kRooftop ? "rooftop" : "ground"; }
-std::string to_string(RadomeLook l) { return l == RadomeLook::kPlain ? "plain" : "weathered"; }
+std::string to_string(RadomeLook l) {
+  switch (l) {
+    case RadomeLook::kPlain:
+      return "plain";
+    case RadomeLook::kWeathered:
+      return "weathered";
+    case RadomeLook::kRibbed:
+      return "ribbed";
+  }
+  return "unknown";
+}
+std::string to_string(Arrangement a) { return a == Arrangement::kSectors ? "sectors" : "side-by-side"; }
 
 AntennaSetting parse_antenna_setting(const std::string& name) {
   if (name == "rooftop") return AntennaSetting::kRooftop;
@@ -66,10 +47,18 @@ AntennaSetting parse_antenna_setting(const std::string& name) {
 }
 
 RadomeLook parse_radome_look(const std::string& name) {
-  if (name == "plain") return RadomeLook::kPlain;
-  if (name == "weathered") return RadomeLook::kWeathered;
-  throw InputError("--radome", fmt::format("'{}' is not plain or weathered", name));
+  for (const auto l : {RadomeLook::kPlain, RadomeLook::kWeathered, RadomeLook::kRibbed})
+    if (to_string(l) == name) return l;
+  throw InputError("--radome", fmt::format("'{}' is not plain, weathered or ribbed", name));
 }
+
+Arrangement parse_arrangement(const std::string& name) {
+  for (const auto a : {Arrangement::kSectors, Arrangement::kSideBySide})
+    if (to_string(a) == name) return a;
+  throw InputError("--arrangement", fmt::format("'{}' is not sectors or side-by-side", name));
+}
+
+Vec3 heading(double azimuth) { return {std::sin(azimuth), std::cos(azimuth), 0.0}; }
 
 model::Mesh box_mesh(const Vec3& h) {
   model::Mesh m;
@@ -137,16 +126,10 @@ AntennaLayout draw_antenna_layout(AntennaSetting setting, int antennas, std::mt1
     a.downtilt = deg2rad(uniform(rng, 0.0, 12.0));
     a.roll = deg2rad(uniform(rng, -2.0, 2.0));
     a.R_world_antenna = rot_antenna(a.azimuth_magnetic, a.downtilt, a.roll);
-    // Out from the mast along the horizontal boresight, so that the nearer bracket's arm is at
-    // least 12 cm long beyond the pole's surface.
-    const Vec3 b_h(std::sin(a.azimuth_magnetic), std::cos(a.azimuth_magnetic), 0.0);
-    double s_min = 0.0;
-    for (const double k_z : {-0.25, 0.25}) {
-      const Vec3 q = a.R_world_antenna * Vec3(0.0, -a.spec.depth_m / 2 - a.spec.bracket_depth_m, k_z * a.spec.height_m);
-      s_min = std::min(s_min, q.dot(b_h));
-    }
-    const double r_c = L.mast_radius_m + 0.12 - s_min;
-    a.p_world_antenna = r_c * b_h + Vec3(0.0, 0.0, z_centre + uniform(rng, -0.05, 0.05));
+    // The nearer bracket's arm 12 cm long beyond the pole's surface.
+    a.mount_radius_m = L.mast_radius_m;
+    a.arm_m = 0.12;
+    a.p_world_antenna = centre_on_mount(a, Vec2::Zero(), a.mount_radius_m, a.arm_m, z_centre + uniform(rng, -0.05, 0.05));
     top = std::max(top, a.p_world_antenna.z() + a.spec.height_m / 2);
     L.antennas.push_back(a);
   }
@@ -159,7 +142,7 @@ std::function<double(const Vec3&)> weathering_reflectance(const model::PanelSpec
   // radome's flat front.
   const double half_w = std::min(0.06, (s.width_m / 2 - s.edge_radius_m) - 0.005);
   const double z0 = -s.height_m / 2 + 0.10, z1 = z0 + 0.08;
-  std::mt19937_64 rng(mix(seed ^ 0x1abe1ULL));
+  std::mt19937_64 rng(mix_bits(seed ^ 0x1abe1ULL));
   std::vector<std::array<double, 4>> bars;  // x0, x1, z0, z1 in the antenna frame
   for (int line = 0; line < 4; ++line) {
     const double zb = z1 - 0.012 - line * 0.017, zt = zb + (line == 0 ? 0.010 : 0.007);
@@ -172,7 +155,7 @@ std::function<double(const Vec3&)> weathering_reflectance(const model::PanelSpec
     }
   }
   const double front = s.depth_m / 2 - 1e-4, back = -s.depth_m / 2 - 1e-4, cap = s.height_m / 2 - 1e-4;
-  const std::uint64_t s1 = mix(seed + 1), s2 = mix(seed + 2), s3 = mix(seed + 3);
+  const std::uint64_t s1 = mix_bits(seed + 1), s2 = mix_bits(seed + 2), s3 = mix_bits(seed + 3);
   return [=](const Vec3& p) {
     if (p.y() < back) return 0.5;           // bracket: galvanised steel
     if (std::abs(p.z()) > cap) return 0.8;  // end caps: a darker grey plastic
@@ -190,21 +173,143 @@ std::function<double(const Vec3&)> weathering_reflectance(const model::PanelSpec
   };
 }
 
-std::vector<MeshObject> antenna_meshes(const AntennaLayout& L, RadomeLook look, std::uint64_t seed) {
+std::array<Vec3, 2> bracket_back_points(const model::PanelSpec& s) {
+  const double kz = 0.5 - s.bracket_end_fraction;
+  return {Vec3(0.0, -s.depth_m / 2 - s.bracket_depth_m, -kz * s.height_m),
+          Vec3(0.0, -s.depth_m / 2 - s.bracket_depth_m, kz * s.height_m)};
+}
+
+Vec3 centre_on_mount(const SimAntenna& a, const Vec2& mount_xy, double mount_radius_m, double arm_m, double z_m) {
+  const Vec3 b_h(std::sin(a.azimuth_magnetic), std::cos(a.azimuth_magnetic), 0.0);
+  double s_min = 0.0;
+  for (const Vec3& bracket : bracket_back_points(a.spec)) {
+    const Vec3 q = a.R_world_antenna * bracket;
+    s_min = std::min(s_min, q.dot(b_h));
+  }
+  const double r_c = mount_radius_m + arm_m - s_min;
+  return r_c * b_h + Vec3(mount_xy.x(), mount_xy.y(), z_m);
+}
+
+std::array<Arm, 2> antenna_arms(const SimAntenna& a) {
+  std::array<Arm, 2> out;
+  const auto brackets = bracket_back_points(a.spec);
+  for (std::size_t k = 0; k < 2; ++k) {
+    const Vec3 q = a.p_world_antenna + a.R_world_antenna * brackets[k];
+    Arm& arm = out[k];
+    arm.name = fmt::format("{}-arm-{}", a.name, k == 0 ? "low" : "high");
+    arm.axis_point = Vec3(a.mount_xy.x(), a.mount_xy.y(), q.z());
+    const Vec3 along = q - arm.axis_point;
+    arm.length_m = along.norm();
+    arm.R_world_arm.col(0) = along / arm.length_m;
+    arm.R_world_arm.col(2) = Vec3::UnitZ();
+    arm.R_world_arm.col(1) = arm.R_world_arm.col(2).cross(arm.R_world_arm.col(0));
+    arm.centre = arm.axis_point + along / 2;
+  }
+  return out;
+}
+
+namespace {
+
+constexpr double kCrease = deg2rad(40.0);
+
+// The panel's parts in the antenna frame: its parametric panel, then the end caps (a panel of
+// the radome's section grown by the caps' thickness, end_cap_height_m long, flush with each end).
+std::vector<model::Mesh> rendered_panel_parts(const SimAntenna& a) {
+  std::vector<model::Mesh> parts{model::parametric_panel(a.spec).mesh_antenna};
+  const PanelFinish& f = a.finish;
+  if (f.end_cap_height_m <= 0.0) return parts;
+  model::PanelSpec cap;
+  cap.width_m = a.spec.width_m + 2 * f.end_cap_thickness_m, cap.depth_m = a.spec.depth_m + 2 * f.end_cap_thickness_m;
+  cap.height_m = f.end_cap_height_m;
+  cap.edge_radius_m = a.spec.edge_radius_m + f.end_cap_thickness_m;
+  cap.arc_segments = a.spec.arc_segments;
+  cap.bracket = false;
+  const model::Mesh cap_mesh = model::parametric_panel(cap).mesh_antenna;
+  for (const double side : {-1.0, 1.0})
+    parts.push_back(model::transformed(
+        cap_mesh, Iso3(Eigen::Translation3d(0.0, 0.0, side * (a.spec.height_m - f.end_cap_height_m) / 2))));
+  return parts;
+}
+
+// Arm and clamp objects (lower pair first), as the classic scenes have always drawn them.
+std::vector<MeshObject> arm_objects(const SimAntenna& a, double arm_albedo, double clamp_albedo) {
   std::vector<MeshObject> out;
-  const double crease = deg2rad(40.0);
+  for (const Arm& arm : antenna_arms(a)) {
+    MeshObject box;
+    box.name = arm.name;
+    box.mesh = box_mesh(Vec3(arm.length_m / 2, 0.025, 0.025));
+    box.R_world_object = arm.R_world_arm;
+    box.p_world_object = arm.centre;
+    box.albedo = arm_albedo;
+    out.push_back(box);
+    MeshObject clamp;
+    clamp.name = fmt::format("{}-clamp-{}", a.name, arm.name.substr(arm.name.rfind('-') + 1));
+    const double c = a.mount_radius_m + 0.015;
+    clamp.mesh = box_mesh(Vec3(c, c, 0.05));
+    clamp.R_world_object = arm.R_world_arm;
+    clamp.p_world_object = arm.axis_point;
+    clamp.albedo = clamp_albedo;
+    out.push_back(clamp);
+  }
+  return out;
+}
+
+MeshObject mast_object(const AntennaLayout& L, double albedo) {
   MeshObject mast;
   mast.name = "mast";
   mast.mesh = cylinder_mesh(Vec3::Zero(), Vec3(0.0, 0.0, L.mast_top_m), L.mast_radius_m, 24);
-  mast.corner_normals = smooth_corner_normals(mast.mesh, crease);
-  mast.albedo = kSteelAlbedo;
-  out.push_back(mast);
+  mast.corner_normals = smooth_corner_normals(mast.mesh, kCrease);
+  mast.albedo = albedo;
+  return mast;
+}
+
+// A finished panel's reflectance: end caps, then the brackets (at the steel's own albedo), then
+// the radome's look.
+std::function<double(const Vec3&)> finish_reflectance(const SimAntenna& a, double metal_albedo, std::uint64_t seed) {
+  const model::PanelSpec& s = a.spec;
+  const PanelFinish& f = a.finish;
+  std::function<double(const Vec3&)> look = [](const Vec3&) { return 1.0; };
+  if (f.look == RadomeLook::kWeathered) look = weathering_reflectance(s, seed);
+  if (f.look == RadomeLook::kRibbed) look = ribbed_reflectance(s, f.rib_period_m, f.rib_contrast);
+  const double cap_from = s.height_m / 2 - std::max(f.end_cap_height_m, 1e-4), back = -s.depth_m / 2 - 1e-4;
+  const double bracket = metal_albedo / f.radome_albedo, cap = f.cap_reflectance;
+  return [=](const Vec3& p) {
+    if (std::abs(p.z()) > cap_from) return cap;
+    if (p.y() < back) return bracket;
+    return look(p);
+  };
+}
+
+}  // namespace
+
+model::Mesh rendered_panel_mesh(const SimAntenna& a) {
+  auto parts = rendered_panel_parts(a);
+  model::Mesh mesh = std::move(parts.front());
+  for (std::size_t i = 1; i < parts.size(); ++i) model::append_mesh(mesh, parts[i]);
+  return mesh;
+}
+
+std::function<double(const Vec3&)> ribbed_reflectance(const model::PanelSpec& s, double period_m, double contrast) {
+  if (!(period_m > 0.0) || !(contrast >= 0.0 && contrast < 1.0))
+    throw std::invalid_argument(fmt::format("ribbed_reflectance: period {} m must be > 0, contrast {} in [0, 1)",
+                                            period_m, contrast));
+  const double front = s.depth_m / 2 - 1e-4;
+  return [=](const Vec3& p) {
+    if (p.y() < front) return 1.0;
+    const double g = 0.5 * (1.0 + std::cos(2.0 * std::numbers::pi * p.x() / period_m));
+    return 1.0 + contrast * (0.375 - g * g);
+  };
+}
+
+std::vector<MeshObject> antenna_meshes(const AntennaLayout& L, RadomeLook look, std::uint64_t seed) {
+  if (look == RadomeLook::kRibbed) throw std::invalid_argument("antenna_meshes: ribbed radomes are finished panels");
+  std::vector<MeshObject> out{mast_object(L, kSteelAlbedo)};
   for (std::size_t k = 0; k < L.antennas.size(); ++k) {
     const SimAntenna& a = L.antennas[k];
     MeshObject panel;
     panel.name = a.name;
-    panel.mesh = model::builtin_panel(a.model_name).mesh_antenna;
-    panel.corner_normals = smooth_corner_normals(panel.mesh, crease);
+    panel.mesh = rendered_panel_mesh(a);
+    panel.corner_normals = smooth_corner_normals(panel.mesh, kCrease);
     panel.R_world_object = a.R_world_antenna;
     panel.p_world_object = a.p_world_antenna;
     panel.albedo = kRadomeAlbedo;
@@ -215,33 +320,35 @@ std::vector<MeshObject> antenna_meshes(const AntennaLayout& L, RadomeLook look, 
       panel.reflectance = [back](const Vec3& p) { return p.y() < back ? 0.5 : 1.0; };  // uniform radome
     }
     out.push_back(panel);
-    // Arms from the mast axis to each bracket's back face, and a clamp around the pole.
-    for (const double kz : {-0.25, 0.25}) {
-      const Vec3 q = a.p_world_antenna +
-                     a.R_world_antenna * Vec3(0.0, -a.spec.depth_m / 2 - a.spec.bracket_depth_m, kz * a.spec.height_m);
-      const Vec3 axis_point(0.0, 0.0, q.z());
-      const Vec3 along = q - axis_point;
-      const double len = along.norm();
-      Mat3 R;
-      R.col(0) = along / len;
-      R.col(2) = Vec3::UnitZ();
-      R.col(1) = R.col(2).cross(R.col(0));
-      MeshObject arm;
-      arm.name = fmt::format("{}-arm-{}", a.name, kz < 0 ? "low" : "high");
-      arm.mesh = box_mesh(Vec3(len / 2, 0.025, 0.025));
-      arm.R_world_object = R;
-      arm.p_world_object = axis_point + along / 2;
-      arm.albedo = kSteelAlbedo * 0.9;
-      out.push_back(arm);
-      MeshObject clamp;
-      clamp.name = fmt::format("{}-clamp-{}", a.name, kz < 0 ? "low" : "high");
-      const double c = L.mast_radius_m + 0.015;
-      clamp.mesh = box_mesh(Vec3(c, c, 0.05));
-      clamp.R_world_object = R;
-      clamp.p_world_object = axis_point;
-      clamp.albedo = kSteelAlbedo * 0.8;
-      out.push_back(clamp);
-    }
+    const auto arms = arm_objects(a, kSteelAlbedo * 0.9, kSteelAlbedo * 0.8);
+    out.insert(out.end(), arms.begin(), arms.end());
+  }
+  return out;
+}
+
+std::vector<MeshObject> finished_antenna_meshes(const AntennaLayout& L, std::uint64_t seed) {
+  const double metal = L.metal_albedo;
+  std::vector<MeshObject> out{mast_object(L, metal)};
+  for (std::size_t k = 0; k < L.antennas.size(); ++k) {
+    const SimAntenna& a = L.antennas[k];
+    MeshObject panel;
+    panel.name = a.name;
+    for (const auto& part : rendered_panel_parts(a)) append_part(panel, part, kCrease);
+    panel.R_world_object = a.R_world_antenna;
+    panel.p_world_object = a.p_world_antenna;
+    panel.albedo = a.finish.radome_albedo;
+    panel.reflectance = finish_reflectance(a, metal, seed * 31 + k);
+    out.push_back(panel);
+    const auto arms = arm_objects(a, metal, 0.85 * metal);
+    out.insert(out.end(), arms.begin(), arms.end());
+  }
+  for (const Strut& s : L.frame) {
+    MeshObject strut;
+    strut.name = s.name;
+    strut.mesh = cylinder_mesh(s.a, s.b, s.radius_m, 16);
+    strut.corner_normals = smooth_corner_normals(strut.mesh, kCrease);
+    strut.albedo = metal;
+    out.push_back(strut);
   }
   return out;
 }

@@ -4,7 +4,6 @@
 #include <array>
 #include <cmath>
 #include <fstream>
-#include <limits>
 #include <memory>
 #include <numbers>
 #include <random>
@@ -17,8 +16,11 @@
 #include "antpose/geomag/wmm.hpp"
 #include "antpose/io/csv.hpp"
 #include "antpose/io/yaml_util.hpp"
+#include "antpose/sim/antenna_capture.hpp"
 #include "antpose/sim/board_texture.hpp"
+#include "antpose/sim/capture_geometry.hpp"
 #include "antpose/sim/random.hpp"
+#include "antpose/sim/wide_site_truth.hpp"
 
 namespace antpose::sim {
 namespace fs = std::filesystem;
@@ -37,90 +39,10 @@ Vec3 random_unit(std::mt19937_64& rng) {
   return v.normalized();
 }
 
-// Rotation taking unit vector a onto unit vector b by the shortest arc.
-Mat3 rotation_between(const Vec3& a, const Vec3& b) {
-  const Vec3 axis = a.cross(b);
-  const double s = axis.norm(), c = a.dot(b);
-  if (s < 1e-12)
-    return c > 0 ? Mat3::Identity()
-                 : exp_so3(std::numbers::pi *
-                           (std::abs(a.x()) < 0.9 ? a.cross(Vec3::UnitX()) : a.cross(Vec3::UnitY())).normalized());
-  return exp_so3(axis / s * std::atan2(s, c));
-}
-
-// Camera looking along `forward`, image "down" as close as possible to `down`, then rolled.
-Mat3 look_rotation(const Vec3& forward, const Vec3& down, double roll) {
-  const Vec3 z = forward.normalized();
-  Vec3 y = down - down.dot(z) * z;
-  if (y.norm() < 1e-9) y = (std::abs(z.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY()).cross(z);
-  y.normalize();
-  const Vec3 x = y.cross(z);
-  Mat3 R;
-  R << x, y, z;
-  return R * rot_z(roll);
-}
-
 using io::yaml_flow_matrix;
 using io::yaml_flow_vector;
 using io::yaml_scalar;
 
-// The board's printed area seen from a camera pose: every corner of extent() widened by
-// `margin_m` projects inside the image with `border_px` to spare.
-bool board_in_view(const camera::CameraIntrinsics& K, const CameraPose& pose, const camera::BoardSpec& board,
-                   const Mat3& R_world_board, const Vec3& p_world_board, double margin_m, double border_px) {
-  const auto [lo, hi] = board.extent();
-  // Sample the outline densely: with distortion a straight edge bows between its corners.
-  for (int i = 0; i <= 8; ++i)
-    for (int j = 0; j <= 8; ++j) {
-      if (i != 0 && i != 8 && j != 0 && j != 8) continue;
-      const Vec3 p_board(lo.x() - margin_m + (hi.x() - lo.x() + 2 * margin_m) * i / 8.0,
-                         lo.y() - margin_m + (hi.y() - lo.y() + 2 * margin_m) * j / 8.0, 0.0);
-      const Vec3 p_camera =
-          pose.R_world_camera.transpose() * (p_world_board + R_world_board * p_board - pose.p_world_camera);
-      if (p_camera.z() < 0.05) return false;
-      // Outside the field of view by a wide margin: the distortion polynomial is meaningless there.
-      const double x = p_camera.x() / p_camera.z(), y = p_camera.y() / p_camera.z();
-      if (std::abs(x) > 1.5 * K.width / K.fx || std::abs(y) > 1.5 * K.height / K.fy) return false;
-      const auto uv = K.project(p_camera);
-      if (!uv || uv->x() < border_px || uv->y() < border_px || uv->x() > K.width - 1 - border_px ||
-          uv->y() > K.height - 1 - border_px)
-        return false;
-    }
-  return true;
-}
-
-Vec3 board_centre(const camera::BoardSpec& board) {
-  const auto [lo, hi] = board.extent();
-  return 0.5 * (lo + hi);
-}
-
-// R_world_board of a board whose printed face looks along n_out (world), with board x along
-// the horizontal `x_hint` (made orthogonal to the board normal).
-Mat3 board_rotation(const Vec3& n_out, double face_normal_z, const Vec3& x_hint) {
-  const Vec3 z = (face_normal_z * n_out).normalized();
-  const Vec3 x = (x_hint - x_hint.dot(z) * z).normalized();
-  Mat3 R;
-  R << x, z.cross(x), z;
-  return R;
-}
-
-struct Waypoint {
-  Mat3 R_world_device;
-  Vec3 p_world_device;
-};
-
-Waypoint device_from_camera(const SimulatedDevice& d, const Mat3& R_world_camera, const Vec3& p_world_camera) {
-  const Mat3 R_world_device = R_world_camera * d.R_device_camera.transpose();
-  return {R_world_device, p_world_camera - R_world_device * d.p_device_camera};
-}
-
-CameraPose camera_pose(const SimulatedDevice& d, const Trajectory& tr, double t) {
-  const Mat3 R_wd = tr.R_world_device(t);
-  return {R_wd * d.R_device_camera, tr.position_world(t) + R_wd * d.p_device_camera};
-}
-
-// Minimum-jerk peak speed is 1.875 × the mean speed (s'(1/2) of 10τ³ − 15τ⁴ + 6τ⁵).
-constexpr double kMinJerkPeak = 1.875;
 constexpr double kMinRateDegS = 10.0, kMaxRateDegS = 40.0;
 
 struct PlannedPlacement {
@@ -194,132 +116,6 @@ bool walk_admissible(const SimulatedDevice& d, const camera::BoardSpec& board, c
   }
   return true;
 }
-
-// --- antenna scenario planning ----------------------------------------------------------------
-
-// World points that must be inside every photo: each panel's mesh vertices (brackets included).
-std::vector<Vec3> antenna_points(const AntennaLayout& layout) {
-  std::vector<Vec3> out;
-  for (const auto& a : layout.antennas)
-    for (const Vec3& v : model::builtin_panel(a.model_name).mesh_antenna.vertices)
-      out.push_back(a.p_world_antenna + a.R_world_antenna * v);
-  return out;
-}
-
-// The board's outline widened by `margin_m`, 9 points per side (edges bow with distortion).
-std::vector<Vec3> board_points(const camera::BoardSpec& board, const BoardPlacement& pl, double margin_m) {
-  const auto [lo, hi] = board.extent();
-  std::vector<Vec3> out;
-  for (int i = 0; i <= 8; ++i)
-    for (int j = 0; j <= 8; ++j) {
-      if (i != 0 && i != 8 && j != 0 && j != 8) continue;
-      const Vec3 p(lo.x() - margin_m + (hi.x() - lo.x() + 2 * margin_m) * i / 8.0,
-                   lo.y() - margin_m + (hi.y() - lo.y() + 2 * margin_m) * j / 8.0, 0.0);
-      out.push_back(pl.p_world_board + pl.R_world_board * p);
-    }
-  return out;
-}
-
-// Smallest distance (px) of the points' projections to the image border; −1 when one is behind
-// the camera or far outside the field of view (where the distortion polynomial means nothing).
-double fit_margin_px(const camera::CameraIntrinsics& K, const CameraPose& pose, const std::vector<Vec3>& points) {
-  double margin = std::numeric_limits<double>::infinity();
-  for (const Vec3& p : points) {
-    const Vec3 pc = pose.R_world_camera.transpose() * (p - pose.p_world_camera);
-    if (pc.z() < 0.05) return -1.0;
-    if (std::abs(pc.x() / pc.z()) > 1.5 * K.width / K.fx || std::abs(pc.y() / pc.z()) > 1.5 * K.height / K.fy)
-      return -1.0;
-    const auto uv = K.project(pc);
-    if (!uv) return -1.0;
-    margin = std::min({margin, uv->x(), uv->y(), K.width - 1 - uv->x(), K.height - 1 - uv->y()});
-  }
-  return margin;
-}
-
-// Camera at c looking so that the points' bounding box (undistorted normalised coordinates) is
-// centred in the image; image y along world down (landscape) or image x along world down
-// (portrait), plus a hand-held roll.
-Mat3 aim_camera(const Vec3& c, const std::vector<Vec3>& points, bool portrait, double roll) {
-  Vec3 f = Vec3::Zero();
-  for (const Vec3& p : points) f += (p - c).normalized();
-  Mat3 R = look_rotation(f, -Vec3::UnitZ(), roll + (portrait ? 0.5 * std::numbers::pi : 0.0));
-  for (int it = 0; it < 4; ++it) {
-    double x0 = std::numeric_limits<double>::infinity(), x1 = -x0, y0 = x0, y1 = -x0;
-    for (const Vec3& p : points) {
-      const Vec3 q = R.transpose() * (p - c);
-      if (q.z() <= 1e-3) return R;
-      x0 = std::min(x0, q.x() / q.z()), x1 = std::max(x1, q.x() / q.z());
-      y0 = std::min(y0, q.y() / q.z()), y1 = std::max(y1, q.y() / q.z());
-    }
-    R = R * rotation_between(Vec3::UnitZ(), Vec3(0.5 * (x0 + x1), 0.5 * (y0 + y1), 1.0).normalized());
-  }
-  return R;
-}
-
-camera::CameraIntrinsics scaled_intrinsics(const camera::CameraIntrinsics& K, int factor) {
-  camera::CameraIntrinsics s = K;
-  s.width = K.width / factor, s.height = K.height / factor;
-  s.fx = K.fx / factor, s.fy = K.fy / factor;
-  // Pixel centres at integers: u_small = (u + 0.5) / factor − 0.5.
-  s.cx = (K.cx + 0.5) / factor - 0.5, s.cy = (K.cy + 0.5) / factor - 0.5;
-  return s;
-}
-
-// The unoccluded fraction of each antenna's silhouette from `pose`, by id renders (scene, and
-// each panel alone) with a low-resolution renderer. Panel k is scene mesh `panel_mesh[k]`.
-std::vector<double> visible_fractions(const PhotoRenderer& low, const Scene& scene,
-                                      const std::vector<std::size_t>& panel_mesh, const CameraPose& pose) {
-  const Lighting lighting;
-  cv::Mat ids;
-  low.render(scene, pose, lighting, &ids);
-  std::vector<double> out;
-  for (const std::size_t m : panel_mesh) {
-    Scene alone;
-    alone.meshes.push_back(scene.meshes[m]);
-    cv::Mat alone_ids;
-    low.render(alone, pose, lighting, &alone_ids);
-    const int id = static_cast<int>(scene.patches.size() + m);
-    const double all = cv::countNonZero(alone_ids == 0);
-    const double seen = cv::countNonZero(ids == id);
-    out.push_back(all > 0 ? seen / all : 0.0);
-  }
-  return out;
-}
-
-// Tripod under a board: three legs from a head below the board's lower edge to the ground, and
-// a post up to the board.
-std::vector<MeshObject> tripod_meshes(const camera::BoardSpec& board, const BoardPlacement& pl, double ground_z) {
-  const auto [lo, hi] = board.extent();
-  // The lowest point of the board's outline (one square of margin) is where the head holds it.
-  Vec3 bottom = pl.p_world_board + pl.R_world_board * Vec3(0.5 * (lo.x() + hi.x()), lo.y() - board.square_m, 0.0);
-  const Vec3 other = pl.p_world_board + pl.R_world_board * Vec3(0.5 * (lo.x() + hi.x()), hi.y() + board.square_m, 0.0);
-  if (other.z() < bottom.z()) bottom = other;
-  const Vec3 n = pl.R_world_board.col(2);
-  const Vec3 head = bottom - Vec3(0.0, 0.0, 0.12) - 0.03 * Vec3(n.x(), n.y(), 0.0).normalized();
-  std::vector<MeshObject> out;
-  MeshObject post;
-  post.name = "tripod-post";
-  post.mesh = cylinder_mesh(head, bottom + Vec3(0.0, 0.0, 0.02), 0.015, 12);
-  post.albedo = 0.15;
-  out.push_back(post);
-  for (int k = 0; k < 3; ++k) {
-    const double a = 2.0 * std::numbers::pi * k / 3.0 + 0.3;
-    const Vec3 foot(head.x() + 0.55 * std::cos(a), head.y() + 0.55 * std::sin(a), ground_z);
-    MeshObject leg;
-    leg.name = fmt::format("tripod-leg-{}", k + 1);
-    leg.mesh = cylinder_mesh(head, foot, 0.012, 10);
-    leg.albedo = 0.15;
-    out.push_back(leg);
-  }
-  return out;
-}
-
-struct AntennaPlan {
-  BoardPlacement board;
-  std::vector<Waypoint> waypoints;  // one per photo
-  bool portrait = true;
-  double walk_azimuth = 0;  // of the walk's centre seen from the mast, rad
-};
 
 void write_binary(const fs::path& file, const std::string& bytes) {
   fs::create_directories(file.parent_path());
@@ -404,6 +200,14 @@ Scenario parse_scenario(const std::string& name) {
       fmt::format("scenario '{}' is not camera-calibration, joint-calibration, planes or antenna", name));
 }
 
+std::string to_string(Distribution d) { return d == Distribution::kClassic ? "classic" : "wide"; }
+
+Distribution parse_distribution(const std::string& name) {
+  if (name == "classic") return Distribution::kClassic;
+  if (name == "wide") return Distribution::kWide;
+  throw InputError("--distribution", fmt::format("'{}' is not classic or wide", name));
+}
+
 camera::BoardSpec default_board(camera::BoardType type) {
   switch (type) {
     case camera::BoardType::kChessboard:
@@ -480,6 +284,9 @@ SimulatedCapture simulate_capture(const CaptureScenario& sc, const fs::path& scr
   // under 15 px at 12 MP.
   if (sc.board_max_distance_m && !(*sc.board_max_distance_m >= 2.5 && *sc.board_max_distance_m <= 15.0))
     throw InputError("--board-max-distance", fmt::format("{} m is outside 2.5..15", *sc.board_max_distance_m));
+  if (antenna && sc.distribution == Distribution::kClassic && sc.radome == RadomeLook::kRibbed)
+    throw InputError("--radome", "'ribbed' is drawn by --distribution wide only; classic radomes are plain or weathered");
+  if (antenna && sc.distribution == Distribution::kWide) validate(sc.wide);
   SimulatedCapture out;
   out.device = make_device(sc.device, sc.device_seed.value_or(sc.seed));
   const SimulatedDevice& d = out.device;
@@ -500,6 +307,7 @@ SimulatedCapture simulate_capture(const CaptureScenario& sc, const fs::path& scr
   const bool has_board = sc.scenario != Scenario::kPlanes;
   Trajectory tr;
   std::vector<std::pair<double, std::size_t>> shot_times;  // (t_true, placement)
+  std::optional<AntennaSitePlan> antenna_plan;
   if (joint) {
     out.placements = joint_placements(board, texture.face_normal_z);
     const Vec3 up = Vec3::UnitZ();
@@ -540,134 +348,15 @@ SimulatedCapture simulate_capture(const CaptureScenario& sc, const fs::path& scr
     }
     tr.hold(1.0);
   } else if (antenna) {
-    // Draw the scene and the walk together; retry until every view fits (see AntennaPlan).
-    AntennaTruth at;
-    at.radome = sc.radome;
-    const bool roof = sc.setting == AntennaSetting::kRooftop;
-    const double board_max = sc.board_max_distance_m.value_or(4.0);
-    const camera::CameraIntrinsics& K = d.intrinsics;
-    const int factor = std::max(1, std::min(K.width, K.height) / 200);
-    const PhotoRenderer low(scaled_intrinsics(K, factor), 1);
-    const int N = sc.photos;
-    const Vec3 up = Vec3::UnitZ();
-    AntennaPlan plan;
-    bool ok = false;
-    double half_site = 0.0;
-    // Three panels on a rooftop, each at least 60 % seen in every photo, are rare draws: one in
-    // 19–139 on the sites 5905–6111, and 6205 had none in 400. Each attempt costs ~10 ms, and the
-    // first admissible one ends the loop, so more attempts change no scene found before.
-    for (int attempt = 0; attempt < 4000 && !ok; ++attempt) {
-      at.layout = draw_antenna_layout(sc.setting, sc.antennas, rng);
-      // The walk: an arc around the mast at horizontal distance D, centred on azimuth phi0 (from
-      // the mast), spanning `span` of viewing directions; the board between walk and mast.
-      const double D = roof ? uniform(rng, 4.0, 10.0) : uniform(rng, 15.0, 30.0);
-      const double phi0 = uniform(rng, 0.0, 2.0 * std::numbers::pi);
-      const double hp = uniform(rng, 1.4, 1.7);
-      const Vec3 out_dir(std::sin(phi0), std::cos(phi0), 0.0);
-      const Vec3 C = D * out_dir + hp * up;
-      const double b = board_max * uniform(rng, 0.55, 0.85), lateral = uniform(rng, -0.3, 0.3);
-      const double zb = roof ? uniform(rng, 1.2, 1.6) : uniform(rng, 1.5, 1.9);
-      // The board stays within board_max (4 m by default) of the phone, which bounds the walk's
-      // half-length to sqrt(board_max² − b²) (less a margin for the jitter) and so the span at
-      // long range (ground).
-      const double s_max = std::sqrt(std::pow(board_max - 0.15, 2) - b * b) - 0.35;
-      const double span_max =
-          std::min(2.0 * std::asin(std::min(1.0, s_max / D)), deg2rad(roof ? uniform(rng, 34.0, 40.0) : 26.0));
-      const double span_min = deg2rad(roof ? 25.0 : 10.0);
-      Vec3 Bc = C - b * out_dir + lateral * out_dir.cross(up);
-      Bc.z() = zb;
-      BoardPlacement pl;
-      pl.name = "tripod";
-      const Vec3 n_out = (C - Bc).normalized();  // facing the middle of the walk
-      pl.R_world_board = board_rotation(n_out, texture.face_normal_z, (-n_out).cross(up));
-      pl.p_world_board = Bc - pl.R_world_board * board_centre(board);
-      std::vector<Vec3> pts = antenna_points(at.layout);
-      const auto bpts = board_points(board, pl, 0.5 * board.square_m);
-      pts.insert(pts.end(), bpts.begin(), bpts.end());
-      // The widest span (in 2° steps) whose every view fits: the baseline matters most.
-      const double border = 0.04 * K.width;
-      std::vector<CameraPose> poses;
-      bool fine = false;
-      for (double span = span_max; span >= span_min && !fine; span -= deg2rad(2.0)) {
-        std::vector<Vec3> cs;
-        fine = true;
-        for (int k = 0; k < N && fine; ++k) {
-          const double psi = phi0 + span * (static_cast<double>(k) / (N - 1) - 0.5);
-          const double Dk = D + uniform(rng, -0.3, 0.3), hk = hp + uniform(rng, -0.05, 0.05);  // sequenced draws
-          const Vec3 c = Dk * Vec3(std::sin(psi), std::cos(psi), 0.0) + hk * up;
-          const double to_board = (c - Bc).norm();
-          fine = to_board >= 1.5 && to_board <= board_max;
-          cs.push_back(c);
-        }
-        if (!fine) continue;
-        // Portrait or landscape, whichever leaves more room at the middle of the walk.
-        const Vec3& cm = cs[static_cast<std::size_t>(N / 2)];
-        double best = -1.0;
-        bool portrait = true;
-        for (const bool p : {true, false}) {
-          const double m = fit_margin_px(K, {aim_camera(cm, pts, p, 0.0), cm}, pts);
-          if (m > best) best = m, portrait = p;
-        }
-        fine = best >= border;
-        poses.clear();
-        plan.waypoints.clear();
-        for (int k = 0; k < N && fine; ++k) {
-          const Vec3& c = cs[static_cast<std::size_t>(k)];
-          const CameraPose pose{aim_camera(c, pts, portrait, deg2rad(uniform(rng, -4.0, 4.0))), c};
-          fine = fit_margin_px(K, pose, pts) >= border;
-          poses.push_back(pose);
-          plan.waypoints.push_back(device_from_camera(d, pose.R_world_camera, c));
-        }
-        plan.portrait = portrait;
-      }
-      if (!fine) continue;
-      // Every antenna mostly unoccluded (by the mast, the other panels, the board) in every view.
-      half_site = D + 6.0;
-      // (The site's patches cannot hide a panel: the phone stands on the roof or the ground below
-      // it; leaving them out saves drawing their textures for every attempt.)
-      Scene check;
-      check.patches.push_back(board_patch(texture, pl.R_world_board, pl.p_world_board, "board"));
-      check.meshes = antenna_meshes(at.layout, RadomeLook::kPlain, sc.seed);
-      std::vector<std::size_t> panel_mesh;
-      for (std::size_t k = 0; k < at.layout.antennas.size(); ++k) panel_mesh.push_back(1 + 5 * k);
-      for (const auto& pose : poses) {
-        for (const double f : visible_fractions(low, check, panel_mesh, pose)) fine = fine && f >= 0.6;
-        if (!fine) break;
-      }
-      if (!fine) continue;
-      plan.board = pl;
-      plan.walk_azimuth = phi0;
-      ok = true;
-    }
-    if (!ok)
-      throw std::runtime_error(fmt::format(
-          "no admissible antenna scene and walk for {} photos of {}x{} px (image too small?)", N, K.width, K.height));
-    out.placements.push_back(plan.board);
-    out.meshes = antenna_meshes(at.layout, sc.radome, sc.seed);
-    const auto tripod = tripod_meshes(board, plan.board, 0.0);
-    out.meshes.insert(out.meshes.end(), tripod.begin(), tripod.end());
-    out.surfaces = antenna_site_patches(at.layout, half_site, sc.seed);
-    // Still for 3 s (first photo in it), then walk: each move at a hand-held pace (≤ 25 °/s
-    // mean turn, ≤ 0.8 m/s), a 0.7 s pause, the photo in the middle of the pause.
-    const auto& wp = plan.waypoints;
-    tr = Trajectory(wp.front().R_world_device, wp.front().p_world_device);
-    tr.hold(3.0);
-    shot_times.emplace_back(2.6, 0);
-    for (std::size_t k = 1; k < wp.size(); ++k) {
-      const double angle = rad2deg(rotation_distance(wp[k - 1].R_world_device, wp[k].R_world_device));
-      const double distance = (wp[k].p_world_device - wp[k - 1].p_world_device).norm();
-      const double T = std::clamp(std::max(kMinJerkPeak * angle / 25.0, kMinJerkPeak * distance / 0.8), 1.0, 4.0);
-      tr.move_to(wp[k].R_world_device, wp[k].p_world_device, T);
-      shot_times.emplace_back(tr.duration() + 0.35, 0);
-      tr.hold(0.7);
-    }
-    tr.hold(1.5);
-    if (sc.disturbance) {
-      // Magnetic north turned by 3–8° (either way) at the middle of the walk.
-      const double target = deg2rad(uniform(rng, 3.0, 8.0)) * (uniform(rng, 0.0, 1.0) < 0.5 ? -1.0 : 1.0);
-      at.dipoles = mast_dipoles(at.layout, field_world_uT, wp[wp.size() / 2].p_world_device, target, rng);
-    }
-    out.antenna = at;
+    antenna_plan = sc.distribution == Distribution::kClassic
+                       ? plan_classic_antenna_site(sc, d, board, texture, field_world_uT, rng)
+                       : plan_wide_antenna_site(sc, out.device, board, texture, field_world_uT);
+    out.placements.push_back(antenna_plan->board);
+    out.meshes = antenna_plan->meshes;
+    out.surfaces = antenna_plan->surfaces;
+    tr = antenna_plan->trajectory;
+    for (const double t : antenna_plan->shot_times) shot_times.emplace_back(t, 0);
+    out.antenna = antenna_plan->truth;
   } else if (!has_board) {
     // A walk through the room: positions at least 2 m from the walls, looking at a wall or at
     // the ground 1–3 m ahead, each move turning the phone at a hand-held rate.
@@ -746,8 +435,9 @@ SimulatedCapture simulate_capture(const CaptureScenario& sc, const fs::path& scr
       tr.hold(1.5);
     }
   }
-  // Hand tremor on top (0.05° rms, 0.2 mm rms): keeps the "still" photos realistically still.
-  tr.with_tremor(deg2rad(0.05), 2e-4, sc.seed);
+  // Hand tremor on top (0.05° rms unless a wide site drew its own, 0.2 mm rms): keeps the
+  // "still" photos realistically still.
+  tr.with_tremor(antenna_plan ? antenna_plan->tremor_rms_rad : deg2rad(0.05), 2e-4, sc.seed);
 
   // IMU streams and orientation truth.
   ImuSimulation imu;
@@ -772,19 +462,27 @@ SimulatedCapture simulate_capture(const CaptureScenario& sc, const fs::path& scr
   const auto& room = out.surfaces;
   Scene scene;
   scene.meshes = out.meshes;
-  const Lighting lighting;
+  const Lighting lighting = antenna_plan ? antenna_plan->lighting : Lighting{};
   std::vector<Vec3> antenna_pts;
-  std::vector<std::size_t> panel_mesh;
+  std::vector<std::vector<Vec3>> panel_vertices;      // per antenna, world
+  std::vector<std::vector<PixelBox>> panel_boxes;     // [antenna][shot]: projected rendered panel
+  std::vector<std::vector<double>> panel_widths;      // [antenna][shot]: apparent width, px
   std::unique_ptr<PhotoRenderer> low;
   if (antenna) {
-    antenna_pts = antenna_points(out.antenna->layout);
+    const AntennaLayout& layout = out.antenna->layout;
+    antenna_pts = antenna_points(layout);
     const auto bpts = board_points(board, out.placements.front(), 0.0);
     antenna_pts.insert(antenna_pts.end(), bpts.begin(), bpts.end());
-    for (std::size_t k = 0; k < out.antenna->layout.antennas.size(); ++k) panel_mesh.push_back(1 + 5 * k);
-    low = std::make_unique<PhotoRenderer>(
-        scaled_intrinsics(d.intrinsics, std::max(1, std::min(d.intrinsics.width, d.intrinsics.height) / 200)), 1);
-    out.antenna->visible_fraction.assign(panel_mesh.size(), {});
-    out.antenna->roi_shot = static_cast<int>(shot_times.size() / 2);
+    for (const auto& a : layout.antennas) {
+      std::vector<Vec3> world;
+      for (const Vec3& v : rendered_panel_mesh(a).vertices) world.push_back(a.p_world_antenna + a.R_world_antenna * v);
+      panel_vertices.push_back(world);
+    }
+    const int factor = std::max(1, std::min(d.intrinsics.width, d.intrinsics.height) / antenna_plan->occlusion_px);
+    low = std::make_unique<PhotoRenderer>(scaled_intrinsics(d.intrinsics, factor), 1);
+    out.antenna->visible_fraction.assign(layout.antennas.size(), {});
+    panel_boxes.assign(layout.antennas.size(), {});
+    panel_widths.assign(layout.antennas.size(), {});
   }
   const int total = static_cast<int>(shot_times.size());
   if (joint) c.shot_extra_columns = {"placement"};
@@ -820,25 +518,12 @@ SimulatedCapture simulate_capture(const CaptureScenario& sc, const fs::path& scr
     if (antenna) {
       AntennaTruth& at = *out.antenna;
       at.north_shift.push_back(north_shift(at.dipoles, field_world_uT, st.p_world_device));
-      const auto fractions = visible_fractions(*low, scene, panel_mesh, pose);
-      for (std::size_t k = 0; k < fractions.size(); ++k) at.visible_fraction[k].push_back(fractions[k]);
-      if (i == at.roi_shot)
-        for (const auto& a : at.layout.antennas) {
-          // Bounding box of the projected mesh vertices, widened by 5 % of its size (at least
-          // 8 px: straight edges bow a little between vertices under distortion), clipped.
-          double u0 = std::numeric_limits<double>::infinity(), u1 = -u0, v0 = u0, v1 = -u0;
-          for (const Vec3& v : model::builtin_panel(a.model_name).mesh_antenna.vertices)
-            if (const auto uv = project_world(d.intrinsics, pose, a.p_world_antenna + a.R_world_antenna * v)) {
-              u0 = std::min(u0, uv->x()), u1 = std::max(u1, uv->x()), v0 = std::min(v0, uv->y()),
-              v1 = std::max(v1, uv->y());
-            }
-          const double m = std::max(8.0, 0.05 * std::max(u1 - u0, v1 - v0));
-          const int x0 = std::max(0, static_cast<int>(std::floor(u0 - m))),
-                    y0 = std::max(0, static_cast<int>(std::floor(v0 - m)));
-          const int x1 = std::min(d.intrinsics.width, static_cast<int>(std::ceil(u1 + m)) + 1);
-          const int y1 = std::min(d.intrinsics.height, static_cast<int>(std::ceil(v1 + m)) + 1);
-          at.roi.emplace_back(x0, y0, x1 - x0, y1 - y0);
-        }
+      const auto fractions = visible_fractions(*low, scene, antenna_plan->panel_mesh, pose);
+      for (std::size_t k = 0; k < fractions.size(); ++k) {
+        at.visible_fraction[k].push_back(fractions[k]);
+        panel_boxes[k].push_back(projected_box(d.intrinsics, pose, panel_vertices[k]));
+        panel_widths[k].push_back(apparent_width_px(d.intrinsics, pose, at.layout.antennas[k]));
+      }
     }
     radiance = motion_blur(radiance, d.intrinsics, d.R_device_camera.transpose() * omega_device, d.sensor.exposure_s);
     const cv::Mat grey = sensor_image(radiance, d.sensor, sc.seed * 1000003ULL + static_cast<std::uint64_t>(i) + 1);
@@ -857,8 +542,9 @@ SimulatedCapture simulate_capture(const CaptureScenario& sc, const fs::path& scr
   }
 
   if (antenna) {
-    // Baseline for triangulation: the largest angle between two viewing directions of each antenna.
     AntennaTruth& at = *out.antenna;
+    choose_rois(at, panel_boxes, panel_widths, d.intrinsics);
+    // Baseline for triangulation: the largest angle between two viewing directions of each antenna.
     for (const auto& a : at.layout.antennas) {
       double span = 0.0;
       for (const auto& s1 : out.shots)
@@ -922,9 +608,9 @@ SimulatedCapture write_simulated_capture(const CaptureScenario& scenario, const 
 
 // --- truth files ----------------------------------------------------------------------------
 
-std::string capture_device_yaml(const SimulatedDevice& d, const ImuSimulation& imu) {
-  YAML::Node root = YAML::Load(device_yaml(imu));
-  const auto& K = d.intrinsics;
+namespace {
+
+YAML::Node camera_node(const camera::CameraIntrinsics& K) {
   YAML::Node cam;
   cam["width_px"] = K.width;
   cam["height_px"] = K.height;
@@ -936,7 +622,18 @@ std::string capture_device_yaml(const SimulatedDevice& d, const ImuSimulation& i
   for (double k : K.distortion) dist.push_back(io::format_number(k));
   dist.SetStyle(YAML::EmitterStyle::Flow);
   cam["distortion"] = dist;
-  root["camera"] = cam;
+  return cam;
+}
+
+}  // namespace
+
+std::string capture_device_yaml(const SimulatedDevice& d, const ImuSimulation& imu) {
+  YAML::Node root = YAML::Load(device_yaml(imu));
+  root["camera"] = camera_node(d.intrinsics);
+  if (d.native_intrinsics) {
+    root["photo_scale"] = yaml_scalar(d.photo_scale);
+    root["native_camera"] = camera_node(*d.native_intrinsics);
+  }
   YAML::Node ci;
   ci["R_device_camera"] = yaml_flow_matrix(d.R_device_camera);
   ci["mounting_error_deg"] = yaml_scalar(d.mounting_error_deg);
@@ -1041,7 +738,7 @@ std::string capture_scene_yaml(const SimulatedCapture& sim, const camera::BoardS
       n["radome"] = to_string(at.radome);
       if (k < at.roi.size()) {
         YAML::Node roi;
-        roi["image"] = sim.shots.at(static_cast<std::size_t>(at.roi_shot)).image;
+        roi["image"] = sim.shots.at(static_cast<std::size_t>(at.roi_shot[k])).image;
         roi["x"] = at.roi[k].x;
         roi["y"] = at.roi[k].y;
         roi["width"] = at.roi[k].width;
@@ -1087,6 +784,7 @@ std::string capture_scene_yaml(const SimulatedCapture& sim, const camera::BoardS
     dist["heading_error_deg"] = err;
     root["disturbance"] = dist;
     for (const auto& m : sim.meshes) root["objects"].push_back(m.name);
+    if (at.wide) add_wide_site_truth(root, at);
   }
   for (const auto& p : sim.surfaces) {
     YAML::Node n;

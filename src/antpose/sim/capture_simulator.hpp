@@ -30,12 +30,12 @@
 //                       the planar patches of room_patches) photographing walls and ground
 //                       mid-move; kind imu-log.
 //   antenna             a mast with 1–3 panel antennas (antenna_scene.hpp) on a roof or on open
-//                       ground, a large board on a tripod 1.5–4 m from the phone; the phone
+//                       ground, a large board on a tripod a few metres from the phone; the phone
 //                       walks an arc around the mast pausing for each photo, every photo showing
-//                       the whole board and every antenna (≥ 60 % unoccluded). The arc is the
-//                       widest that keeps both in view: 27–37° of viewing directions on a roof,
-//                       only 8–13° on the ground (the 4 m board limit bounds the walk to ±2–3 m
-//                       at 20–33 m range); optional magnetised-mast disturbance.
+//                       the whole board and every antenna; optional magnetised-mast disturbance.
+//                       Two distributions of sites (antenna_capture.hpp): `classic`, the narrow
+//                       scenes the measurement was first tuned on (kept draw for draw), and
+//                       `wide` (antenna_site.hpp), drawn from wide ranges of everything.
 // Every truth/scene.yaml lists the room's planes, so photos can be re-rendered or scored.
 #pragma once
 
@@ -50,6 +50,7 @@
 #include "antpose/camera/camera_model.hpp"
 #include "antpose/io/capture.hpp"
 #include "antpose/sim/antenna_scene.hpp"
+#include "antpose/sim/antenna_site.hpp"
 #include "antpose/sim/imu_simulator.hpp"
 #include "antpose/sim/photo_simulator.hpp"
 
@@ -58,7 +59,11 @@ namespace antpose::sim {
 /// The simulated phone: IMU error model, camera, camera–IMU geometry and clock offset.
 struct SimulatedDevice {
   PhoneModel phone = PhoneModel::typical();
-  camera::CameraIntrinsics intrinsics;
+  camera::CameraIntrinsics intrinsics;  // of the photos
+  /// Wide antenna sites: the photos are the native frame resized by photo_scale; the camera at
+  /// its native size.
+  std::optional<camera::CameraIntrinsics> native_intrinsics;
+  double photo_scale = 1.0;
   Mat3 R_device_camera = camera::nominal_R_device_camera();
   Vec3 p_device_camera = Vec3::Zero();  // camera centre in the device frame, m
   double mounting_error_deg = 0.0;      // angle of nominal_R_device_camera()^T R_device_camera
@@ -86,6 +91,13 @@ enum class Scenario { kCameraCalibration, kJointCalibration, kPlanes, kAntenna }
 std::string to_string(Scenario scenario);
 /// "camera-calibration" | "joint-calibration" | "planes" | "antenna"; std::invalid_argument otherwise.
 Scenario parse_scenario(const std::string& name);
+
+/// The antenna scenario's distribution of sites: the narrow classic scenes (reproduced draw for
+/// draw: regression sites are stored as seeds) or the wide one (antenna_site.hpp).
+enum class Distribution { kClassic, kWide };
+std::string to_string(Distribution distribution);
+/// "classic" | "wide"; InputError naming --distribution otherwise.
+Distribution parse_distribution(const std::string& name);
 
 /// A board placement of the joint-calibration scenario.
 struct BoardPlacement {
@@ -120,11 +132,17 @@ struct CaptureScenario {
   AntennaSetting setting = AntennaSetting::kRooftop;  // antenna
   int antennas = 1;                                   // antenna: 1..3
   bool disturbance = false;                           // antenna: magnetised mast (antenna_scene.hpp)
-  RadomeLook radome = RadomeLook::kWeathered;         // antenna
+  Distribution distribution = Distribution::kWide;    // antenna
+  /// antenna: classic default weathered (ribbed is wide only); wide: drawn when unset.
+  std::optional<RadomeLook> radome;
   /// antenna: the board's greatest distance from the phone along the walk, m, which bounds the
   /// walk's length and so its span of viewing directions; the board stands 0.55–0.85 of it ahead
-  /// of the walk's middle. Default 4 (docs/simulator.md); 2.5..15.
+  /// of the walk's middle. Default 4 (classic) or drawn in 3.5–6 (wide); 2.5..15.
   std::optional<double> board_max_distance_m;
+  /// antenna, wide: the draws fixed (the photo pipeline's fixes override `device`'s values, which
+  /// wide sites otherwise draw; the radome, board distance and time offset come from the fields
+  /// above and from device.time_offset_s).
+  WideSiteFixes wide;
   Site site{30.26, 120.12, 20.0, "2025-06-01"};
   /// Called after each photo with (photos done, photos in all).
   std::function<void(int, int)> progress;
@@ -146,13 +164,15 @@ struct ShotTruth {
 /// Truth of the antenna scenario.
 struct AntennaTruth {
   AntennaLayout layout;
-  RadomeLook radome = RadomeLook::kWeathered;
+  RadomeLook radome = RadomeLook::kWeathered;         // classic: every panel's
   std::vector<MagneticDipole> dipoles;                // empty without disturbance
   std::vector<double> north_shift;                    // per shot, rad (north_shift in antenna_scene.hpp)
-  int roi_shot = 0;                                   // the photo the regions of interest are in (the middle one)
+  std::vector<int> roi_shot;                          // per antenna: the photo its region of interest is in
   std::vector<cv::Rect> roi;                          // per antenna: its projection's bounding box + margin, clipped
+  std::vector<double> width_px;                       // per antenna: its apparent width in its ROI photo
   std::vector<std::vector<double>> visible_fraction;  // [antenna][shot]: unoccluded part of its silhouette
   std::vector<double> viewing_span_deg;               // per antenna: largest angle between two viewing directions
+  std::optional<SiteDraw> wide;                       // the drawn parameters of a wide site
 };
 
 struct SimulatedCapture {
@@ -176,11 +196,12 @@ SimulatedCapture simulate_capture(const CaptureScenario& scenario, const std::fi
 SimulatedCapture write_simulated_capture(const CaptureScenario& scenario, const std::filesystem::path& folder,
                                          bool overwrite);
 
-/// truth/device.yaml: the IMU model of device_yaml(imu) plus `camera:` (width_px, height_px,
-/// fx_px, fy_px, cx_px, cy_px, distortion [k1, k2, p1, p2, k3]), `camera_imu:` (R_device_camera
-/// rows, mounting_error_deg, p_device_camera_m, time_offset_s and its definition) and `photo:`
-/// (exposure_s, blur_sigma_px, noise_scale, full_well_e, read_noise_e, gain, gamma,
-/// jpeg_quality, supersampling).
+/// truth/device.yaml: the IMU model of device_yaml(imu) plus `camera:` (the photos': width_px,
+/// height_px, fx_px, fy_px, cx_px, cy_px, distortion [k1, k2, p1, p2, k3]), `camera_imu:`
+/// (R_device_camera rows, mounting_error_deg, p_device_camera_m, time_offset_s and its
+/// definition) and `photo:` (exposure_s, blur_sigma_px, noise_scale, full_well_e, read_noise_e,
+/// gain, gamma, jpeg_quality, supersampling); with native intrinsics (wide antenna sites) also
+/// `photo_scale` and `native_camera:` (as camera).
 std::string capture_device_yaml(const SimulatedDevice& device, const ImuSimulation& imu);
 
 /// truth/scene.yaml (see docs/simulator.md): world, declination_deg, board and placements (name,

@@ -274,6 +274,15 @@ Trajectory& Trajectory::move_to(const Mat3& R_world_device, const Vec3& p_world,
   return *this;
 }
 
+Trajectory& Trajectory::walk_to(const Mat3& R_world_device, const Vec3& p_world, double duration_s,
+                                const GaitBob& bob) {
+  if (!(bob.amplitude_m >= 0.0) || !(bob.frequency_hz > 0.0))
+    throw std::invalid_argument("Trajectory::walk_to: the bob's amplitude must be >= 0 and its frequency > 0");
+  move_to(R_world_device, p_world, duration_s);
+  segments_.back().bob = bob;
+  return *this;
+}
+
 Trajectory& Trajectory::with_tremor(double rotation_rms_rad, double translation_rms_m, std::uint64_t seed) {
   if (!(rotation_rms_rad >= 0.0) || !(translation_rms_m >= 0.0))
     throw std::invalid_argument("Trajectory::with_tremor: amplitudes must be >= 0");
@@ -329,6 +338,19 @@ const Trajectory::Segment& Trajectory::segment_at(double t) const {
 }
 
 namespace {
+
+// The gait bob's height and its second time derivative at t inside a segment (GaitBob).
+std::pair<double, double> bob_height(const GaitBob& bob, double t_in, double duration) {
+  if (bob.amplitude_m == 0.0) return {0.0, 0.0};
+  const double tau = std::clamp(t_in / duration, 0.0, 1.0), u = tau * (1.0 - tau);
+  const double w = 64.0 * u * u * u;
+  const double dw = 192.0 * u * u * (1.0 - 2.0 * tau) / duration;
+  const double ddw = 384.0 * u * ((1.0 - 2.0 * tau) * (1.0 - 2.0 * tau) - u) / (duration * duration);
+  const double omega = 2.0 * std::numbers::pi * bob.frequency_hz;
+  const double sn = std::sin(omega * t_in), cs = std::cos(omega * t_in);
+  return {bob.amplitude_m * w * sn, bob.amplitude_m * (ddw * sn + 2.0 * dw * omega * cs - w * omega * omega * sn)};
+}
+
 template <typename Sinusoids>
 Vec3 sum_sin(const Sinusoids& list, double t, int derivative) {
   Vec3 out = Vec3::Zero();
@@ -365,6 +387,7 @@ Vec3 Trajectory::position_world(double t) const {
   t = std::clamp(t, 0.0, duration());
   const Profile p = min_jerk((t - s.t0) / s.duration);
   Vec3 x = s.p0 + p.s * s.dp;
+  if (s.bob.amplitude_m > 0.0) x.z() += bob_height(s.bob, t - s.t0, s.duration).first;
   if (!tremor_translation_.empty()) x += sum_sin(tremor_translation_, t, 0);
   return x;
 }
@@ -388,6 +411,7 @@ Vec3 Trajectory::acceleration_world(double t) const {
   if (t < 0.0 || t > duration()) return Vec3::Zero();
   const Profile p = min_jerk((t - s.t0) / s.duration);
   Vec3 a = s.moving ? Vec3(p.dds / (s.duration * s.duration) * s.dp) : Vec3::Zero();
+  if (s.bob.amplitude_m > 0.0) a.z() += bob_height(s.bob, t - s.t0, s.duration).second;
   if (!tremor_translation_.empty()) a += sum_sin(tremor_translation_, t, 2);
   return a;
 }

@@ -96,6 +96,14 @@ struct MagneticDipole {
 /// (μ0/(4π) = 1e-7 T·m/A); |r| is floored at 5 cm (the field inside steel is not a dipole's).
 Vec3 dipole_field_uT(const MagneticDipole& dipole, const Vec3& p_world);
 
+/// The vertical bob of a walker's hand: each step lifts and lowers the body (Zijlstra & Hof,
+/// "Displacement of the pelvis during human walking", Gait & Posture 1997: 2–5 cm at the pelvis,
+/// about two steps per second).
+struct GaitBob {
+  double amplitude_m = 0.0;    // 0: none
+  double frequency_hz = 2.0;   // steps per second
+};
+
 /// A trajectory of the device: R_world_device(t) and position p_world(t), built from segments
 /// (holds and smooth minimum-jerk moves) with an optional hand tremor on top. Time runs from 0
 /// to duration(); queries outside are clamped. The start pose is identity at the origin unless
@@ -116,6 +124,10 @@ class Trajectory {
   Trajectory& rotate_to(const Mat3& R_world_device, double duration_s);
   /// Same with a simultaneous minimum-jerk translation to `p_world` (m).
   Trajectory& move_to(const Mat3& R_world_device, const Vec3& p_world, double duration_s);
+  /// move_to walked: plus the vertical bob A w(τ) sin(2π f (t − t0)), faded in and out by
+  /// w(τ) = 64 τ³ (1 − τ)³ (which starts and ends with zero position, velocity and acceleration,
+  /// so the holds around the walk stay still). Orientation and rate as move_to.
+  Trajectory& walk_to(const Mat3& R_world_device, const Vec3& p_world, double duration_s, const GaitBob& bob);
   /// Hand tremor over the whole trajectory: R = R_nominal exp(θ(t)), p = p_nominal + δ(t), with
   /// θ and δ sums of sinusoids — 30 % of the variance in the physiological 8–12 Hz band, 70 %
   /// in a slow drift (0.05–0.5 Hz). `rotation_rms_rad` is the RMS of |θ|, `translation_rms_m`
@@ -144,6 +156,7 @@ class Trajectory {
     Vec3 rotvec = Vec3::Zero();  // log(R0^T R1), body frame
     Vec3 p0 = Vec3::Zero(), dp = Vec3::Zero();
     bool moving = false;
+    GaitBob bob;  // walked moves only
   };
   struct Sinusoid {
     Vec3 amplitude;  // per axis

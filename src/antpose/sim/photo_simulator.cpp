@@ -151,6 +151,14 @@ std::vector<std::array<Vec3, 3>> smooth_corner_normals(const model::Mesh& mesh, 
   return out;
 }
 
+void append_part(MeshObject& object, const model::Mesh& part, double crease_rad) {
+  if (object.corner_normals.size() != object.mesh.triangles.size())
+    throw std::invalid_argument(fmt::format("append_part: mesh '{}' is flat-shaded", object.name));
+  const auto normals = smooth_corner_normals(part, crease_rad);
+  model::append_mesh(object.mesh, part);
+  object.corner_normals.insert(object.corner_normals.end(), normals.begin(), normals.end());
+}
+
 namespace {
 
 // Per-photo geometry of one patch, in floats for the inner loop.
@@ -244,6 +252,25 @@ struct TriangleView {
 };
 
 }  // namespace
+
+double sky_radiance(const Lighting& lighting, const Vec3& direction_world) {
+  if (!lighting.dome) return lighting.sky;
+  const SkyDome& dome = *lighting.dome;
+  const Vec3 d = direction_world.normalized();
+  const double up = std::max(0.0, d.z());
+  double radiance = dome.horizon + (dome.zenith - dome.horizon) * std::sqrt(up);
+  if (dome.clouds && up > 0.02) {
+    constexpr double kLayer = 1000.0;  // m
+    const Texture& t = *dome.clouds;
+    const double x = kLayer * d.x() / d.z(), y = kLayer * d.y() / d.z();
+    const auto& A = t.texel_from_patch;
+    const float tex = bilinear(t.levels.front(), static_cast<float>(A(0, 0) * x + A(0, 1) * y + A(0, 2)) - 0.5f,
+                               static_cast<float>(A(1, 0) * x + A(1, 1) * y + A(1, 2)) - 0.5f, t.repeat);
+    const double fade = std::clamp((up - 0.02) / 0.23, 0.0, 1.0);
+    radiance *= 1.0 + fade * (2.0 * tex - 1.0);
+  }
+  return radiance;
+}
 
 cv::Mat PhotoRenderer::render(const std::vector<TexturedPatch>& patches, const CameraPose& pose,
                               const Lighting& lighting) const {
@@ -403,8 +430,14 @@ cv::Mat PhotoRenderer::render(const Scene& scene, const CameraPose& pose, const 
         const std::size_t tile = static_cast<std::size_t>((v / kTile) * tiles_x_ + u / kTile);
         const std::uint32_t t_begin = tris.empty() ? 0 : tile_start[tile],
                             t_end = tris.empty() ? 0 : tile_start[tile + 1];
+        // The sky is smooth: one value per pixel, along its centre's ray, computed when a sample misses.
+        float sky_px = lighting.dome ? -1.0f : sky;
+        const auto pixel_sky = [&] {
+          if (sky_px < 0.0f) sky_px = static_cast<float>(sky_radiance(lighting, R_wc * Vec3(xc, yc, 1.0)));
+          return sky_px;
+        };
         if (candidates.empty() && t_begin == t_end) {
-          out_row[u] = sky;
+          out_row[u] = pixel_sky();
           if (id_row) id_row[u] = -1;
           continue;
         }
@@ -466,7 +499,7 @@ cv::Mat PhotoRenderer::render(const Scene& scene, const CameraPose& pose, const 
               continue;
             }
             if (bk < 0) {
-              sum += sky;
+              sum += pixel_sky();
               if (id_row && sample == centre_sample) id_row[u] = -1;
               continue;
             }

@@ -102,6 +102,11 @@ struct MeshObject {
 /// stay sharp. Normals follow the winding (model/mesh.hpp).
 std::vector<std::array<Vec3, 3>> smooth_corner_normals(const model::Mesh& mesh, double crease_rad);
 
+/// Appends a closed part to a mesh object, its corner normals smoothed on their own (the parts
+/// of one object, such as a panel and its end caps, are not smoothed into each other).
+/// std::invalid_argument when the object is flat-shaded (no corner normals) but has triangles.
+void append_part(MeshObject& object, const model::Mesh& part, double crease_rad);
+
 /// What a photo shows: planar patches and meshes. Object ids (PhotoRenderer::render) number the
 /// patches 0..P−1, then the meshes P..P+M−1.
 struct Scene {
@@ -109,13 +114,27 @@ struct Scene {
   std::vector<MeshObject> meshes;
 };
 
+/// A sky whose radiance changes from the horizon to the zenith, L = horizon + (zenith − horizon)
+/// √sin(elevation) (rays below the horizon see the horizon), optionally with clouds on a layer
+/// 1 km up: the sky times 2·texture at the ray's point on the layer, faded out towards the
+/// horizon where the layer's texture would alias.
+struct SkyDome {
+  double zenith = 0.9, horizon = 0.9;
+  /// A tileable texture (Texture::repeat) of mean 0.5 over the layer's metres; empty: clear.
+  std::shared_ptr<const Texture> clouds;
+};
+
 /// A distant light and an ambient term (see the file comment).
 struct Lighting {
   Vec3 towards_light_world = Vec3(0.3, -0.5, 0.81).normalized();  // sun in the south-east, 54° high
   double ambient = 0.6;
   double direct = 0.4;
-  double sky = 0.9;  // radiance of a ray that hits no patch
+  double sky = 0.9;               // radiance of a ray that hits no patch
+  std::optional<SkyDome> dome;    // replaces the uniform `sky` when set
 };
+
+/// Radiance of the sky along a world direction (any length): `sky`, or the dome's.
+double sky_radiance(const Lighting& lighting, const Vec3& direction_world);
 
 /// Pose of the camera: R_world_camera rotates camera-frame vectors into the world; the optical
 /// centre is at p_world_camera, m.

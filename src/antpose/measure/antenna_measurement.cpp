@@ -1,0 +1,272 @@
+#include "antpose/measure/antenna_measurement.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include <fmt/format.h>
+
+#include "antpose/camera/board_pose.hpp"
+#include "antpose/model/sampling.hpp"
+#include "antpose/reconstruction/mast_search.hpp"
+
+namespace antpose::measure {
+namespace {
+
+std::pair<Vec3, Vec3> board_box(const camera::BoardSpec& board, const AntennaOptions& o) {
+  const auto [lo, hi] = board.extent();
+  const double m = o.board_margin_squares * board.square_m;
+  const Vec3 margin(m, m, o.board_thickness_m);
+  return {lo - margin, hi + margin};
+}
+
+cv::Rect rect_of(const reconstruction::Roi& r) { return {r.x, r.y, r.width, r.height}; }
+
+// The mast the antenna hangs on (reconstruction/mast.hpp), from the region's points off the
+// registered panel turned any way about its axis, its outline sought below the panel where it
+// stands alone.
+std::optional<reconstruction::Mast> find_mast(const PointCloud& cloud_board, const Iso3& T_board_antenna,
+                                              const Vec3& size_m, const CaptureContext& capture,
+                                              const AntennaOptions& o) {
+  const Iso3 T_antenna_board = T_board_antenna.inverse();
+  const double across = 0.5 * size_m.head<2>().norm() + o.mast_clearance_m;
+  const double along = 0.5 * size_m.z() + o.mast_clearance_m;
+  PointCloud beyond;
+  for (const Vec3& p : cloud_board.points) {
+    const Vec3 a = T_antenna_board * p;
+    if (a.head<2>().norm() > across || std::abs(a.z()) > along) beyond.points.push_back(p);
+  }
+  const double bottom = capture.up_board.dot(T_board_antenna.translation()) - along;
+  return reconstruction::fit_mast(beyond, capture.up_board, capture.poses->views, capture.poses->intrinsics,
+                                  bottom - o.mast_outline_below_m, bottom, o.mast_options);
+}
+
+// The mast by its outline alone (reconstruction/mast_search.hpp), the panel as registered, the
+// board and the neighbours masked in every photo.
+std::optional<reconstruction::Mast> find_mast_outline(const Iso3& T_board_antenna, const Vec3& size_m,
+                                                      const CaptureContext& c, const SceneObjects& objects,
+                                                      const AntennaOptions& o) {
+  std::vector<std::vector<std::vector<cv::Point2f>>> occluders;
+  std::vector<KnownBox> boxes = objects.neighbours;
+  boxes.push_back({T_board_antenna, size_m});
+  for (const auto& v : c.poses->views) {
+    auto& here = occluders.emplace_back();
+    here.push_back(board_outline(objects.board_box, c.poses->intrinsics, v.R_camera_board, v.t_camera_board));
+    for (const auto& b : boxes) here.push_back(box_hull(b, c.poses->intrinsics, v.R_camera_board, v.t_camera_board));
+  }
+  return reconstruction::find_mast_by_outline(c.poses->views, c.poses->intrinsics, c.up_board, T_board_antenna, size_m,
+                                              occluders, o.mast_search);
+}
+
+// The mast from the region's points, else by its outline alone.
+std::optional<reconstruction::Mast> find_any_mast(const PointCloud& cloud_board, const Iso3& T_board_antenna,
+                                                  const Vec3& size_m, const CaptureContext& c,
+                                                  const SceneObjects& objects, const AntennaOptions& o) {
+  if (auto mast = find_mast(cloud_board, T_board_antenna, size_m, c, o)) return mast;
+  return find_mast_outline(T_board_antenna, size_m, c, objects, o);
+}
+
+// The share of the region's points the model at the pose explains, and their RMS distance.
+std::pair<double, double> points_fit(const PointCloud& cloud, const PointCloud& model_board, double reach) {
+  if (cloud.empty() || model_board.empty()) return {0.0, 0.0};
+  const registration::KdTree tree(model_board.points);
+  double ss = 0.0;
+  std::size_t near = 0;
+  for (const auto& p : cloud.points) {
+    std::size_t index = 0;
+    double d2 = 0.0;
+    if (tree.nearest(p, index, d2, reach * reach)) ss += d2, ++near;
+  }
+  return {static_cast<double>(near) / static_cast<double>(cloud.size()),
+          near ? std::sqrt(ss / static_cast<double>(near)) : 0.0};
+}
+
+// The world azimuth (deg, magnetic) from which a photo would show the panel's side.
+double side_view_azimuth_deg(const Mat3& R_board_antenna, const BoardWorldAttitude& board) {
+  const Vec3 x = board.R_world_board * R_board_antenna.col(0);
+  return std::fmod(rad2deg(std::atan2(x.x(), x.y())) + 360.0, 360.0);
+}
+
+// The measurement's verdict in words: ambiguous poses widen the σ; front and back left open
+// refuse the antenna, naming both answers and the photo that would settle them.
+void explain_verdict(AntennaMeasurement& m, const registration::AntennaRegistration& r, const CaptureContext& c) {
+  if (r.verdict == registration::RegistrationVerdict::kFrontBackOpen) {
+    const auto a = antenna_attitude(*c.board, m.R_board_antenna, Mat3::Zero(), *c.site).magnetic;
+    const double az = rad2deg(a.azimuth.value_or(0.0));
+    m.error = fmt::format(
+        "front and back cannot be told apart in these photos (no mast was found behind either face, and neither "
+        "the structure on its sides nor the mount's points decide): the magnetic azimuth is {:.1f}° with downtilt "
+        "{:+.1f}°, or {:.1f}° with downtilt {:+.1f}°; "
+        "add photos from the antenna's side (from a magnetic azimuth near {:.0f}°, seen from the mast) where its "
+        "brackets and mount show",
+        az, rad2deg(a.downtilt), std::fmod(az + 180.0, 360.0), -rad2deg(a.downtilt),
+        side_view_azimuth_deg(m.R_board_antenna, *c.board));
+    return;
+  }
+  if (r.verdict == registration::RegistrationVerdict::kAmbiguousShape && r.selection.runner_up) {
+    const auto& v = *r.selection.runner_up;
+    m.warnings.push_back(fmt::format(
+        "the registration is ambiguous: {} other pose(s) fit the photos and points about as well (score difference "
+        "{:.3f} ± {:.3f} over {} units); the σ of each angle covers them; photos over a wider arc round the antenna "
+        "would settle it",
+        r.rivals.size(), v.difference, v.standard_error, v.units));
+  }
+}
+
+void apply_registration(AntennaMeasurement& m, const model::AntennaModel& model,
+                        const registration::AntennaRegistration& r, const CaptureContext& c, const AntennaOptions& o) {
+  m.R_board_antenna = r.T_board_antenna.linear();
+  m.p_board_antenna = r.T_board_antenna.translation();
+  m.cov_board = r.rotation_covariance_board + c.cov_poses_board;
+  for (const auto& rival : r.rivals) m.rivals_board.push_back(rival.linear());
+  m.verdict = r.verdict;
+  m.runner_up = r.selection.runner_up;
+  m.front_back = r.selection.front_back;
+  m.front_back_cue = r.selection.front_back_cue;
+  m.silhouette_rms_px = r.outline_rms_px;
+  m.candidates = r.proposed;
+  m.registration_candidates = r.candidates;
+  m.method = fmt::format("model {}, outline in {} photos + points", model.name, r.outline_views);
+  const model::AntennaModel& fitted = r.edge_radius ? r.edge_radius->model : model;
+  if (r.edge_radius) m.edge_radius_m = r.edge_radius->radius_m, m.edge_radii_within_m = r.edge_radius->within_m;
+  m.model_board = transformed(model::sample_surface(fitted.mesh_antenna, 0.01, 1), r.T_board_antenna);
+  std::tie(m.fitness, m.fit_rmse_m) = points_fit(m.region.cloud_board, m.model_board, o.reach_m);
+  if (m.fit_rmse_m > o.warn_rmse_m)
+    m.warnings.push_back(fmt::format("poor registration fit: RMS {:.1f} mm (more than {:.0f} mm)", 1e3 * m.fit_rmse_m,
+                                     1e3 * o.warn_rmse_m));
+  if (m.fitness < o.warn_fitness)
+    m.warnings.push_back(fmt::format(
+        "only {:.0f} % of the region's points lie near the registered model: the region holds other objects (mast, "
+        "arms, other panels) or its points are sparse (a plain radome)",
+        100 * m.fitness));
+  if (rad2deg(r.dilation_yaw_sigma_rad) > o.warn_dilation_yaw_sigma_deg)
+    m.warnings.push_back(fmt::format(
+        "the outline's width barely changes with yaw in these photos: a blur of a fraction of a pixel turns the yaw "
+        "by {:.1f}°, which the azimuth σ includes; photograph the antenna over a wider arc or from nearer",
+        rad2deg(r.dilation_yaw_sigma_rad)));
+  explain_verdict(m, r, c);
+}
+
+void measure_model_free(AntennaMeasurement& m, const CaptureContext& c, const AntennaOptions& o) {
+  std::vector<Vec3> viewpoints;
+  for (const auto& v : c.poses->views) viewpoints.push_back(camera::camera_centre(v.R_camera_board, v.t_camera_board));
+  const FaceFit fit = fit_front_face(m.region.cloud_board, viewpoints, c.up_board, o.model_free);
+  m.method = "model-free (front face + long axis)";
+  m.R_board_antenna = fit.R_scene_antenna;
+  m.p_board_antenna = fit.centre_scene;
+  m.cov_board = fit.covariance + c.cov_poses_board;
+  m.fit_rmse_m = fit.rmse_m;
+  m.fitness = fit.inlier_share;
+  m.warnings.insert(m.warnings.end(), fit.warnings.begin(), fit.warnings.end());
+}
+
+// The largest angle between two photos' lines of sight to `p_board` (rad).
+double viewing_span(const std::vector<reconstruction::PosedView>& views, const Vec3& p_board) {
+  double span = 0.0;
+  for (std::size_t a = 0; a < views.size(); ++a)
+    for (std::size_t b = a + 1; b < views.size(); ++b)
+      span = std::max(span,
+                      angle_between(camera::camera_centre(views[a].R_camera_board, views[a].t_camera_board) - p_board,
+                                    camera::camera_centre(views[b].R_camera_board, views[b].t_camera_board) - p_board));
+  return span;
+}
+
+// Where the antenna is before it is registered: its points' centroid, else the middle of the
+// depths where the model fills the rectangle, on the rectangle's central ray.
+Vec3 rough_centre(const AntennaMeasurement& m, const model::AntennaModel* model, const CaptureContext& c) {
+  if (!m.region.cloud_board.empty() || !model) return centroid(m.region.cloud_board.points);
+  const auto& K = c.poses->intrinsics;
+  const auto& v = c.poses->views[m.region_view];
+  const auto [near, far] = depths_filling(model->size_m, rect_of(m.roi.roi), K);
+  const Vec3 ray = K.ray(Vec2(m.roi.roi.x + 0.5 * m.roi.roi.width, m.roi.roi.y + 0.5 * m.roi.roi.height));
+  return v.R_camera_board.transpose() * (ray / ray.z() * (0.5 * (near + far)) - v.t_camera_board);
+}
+
+}  // namespace
+
+OptionProblems AntennaOptions::Check() const {
+  OptionProblems p;
+  p.nest("registration", registration.Check());
+  p.require(board_margin_squares >= 0 && board_thickness_m >= 0, "board_margin_squares, board_thickness_m", "≥ 0");
+  p.require(mast_clearance_m >= 0 && mast_outline_below_m > 0, "mast_clearance_m, mast_outline_below_m",
+            "clearance ≥ 0, stretch > 0");
+  p.require(reach_m > 0, "reach_m", "positive");
+  p.require(region.min_points >= 1, "region.min_points", "at least 1");
+  return p;
+}
+
+AntennaRoi parse_roi(const std::string& text) {
+  const auto colon = text.rfind(':');
+  AntennaRoi r;
+  int w = 0, h = 0, x = 0, y = 0;
+  char tail = 0;
+  if (colon == std::string::npos || colon == 0 ||
+      std::sscanf(text.c_str() + colon + 1, "%d,%d,%d,%d%c", &x, &y, &w, &h, &tail) != 4)
+    throw InputError("--roi", fmt::format("'{}' is not IMAGE:x,y,w,h (e.g. images/img_003.jpg:1200,300,400,1500, "
+                                          "pixels of that photo)",
+                                          text));
+  if (x < 0 || y < 0 || w < 8 || h < 8)
+    throw InputError("--roi", fmt::format("'{}': x and y must be ≥ 0 and the width and height at least 8 px", text));
+  r.image = text.substr(0, colon);
+  r.roi = {x, y, w, h};
+  return r;
+}
+
+reconstruction::RegionReconstruction antenna_region(const CaptureContext& c, std::size_t region_view,
+                                                    const AntennaRoi& roi, const model::AntennaModel* model,
+                                                    const AntennaOptions& o, const reconstruction::Progress& progress) {
+  auto region_options = o.region;
+  region_options.exclude_board = board_box(c.board_spec, o);
+  if (model) {
+    region_options.allow_few_points = true;
+    region_options.expected_depth_m = depths_filling(model->size_m, rect_of(roi.roi), c.poses->intrinsics);
+  }
+  return reconstruction::reconstruct_region(c.poses->views, c.poses->refined, region_view, roi.roi, c.poses->intrinsics,
+                                            region_options, progress);
+}
+
+void measure_antenna(AntennaMeasurement& m, const model::AntennaModel* model, const CaptureContext& c,
+                     const std::vector<KnownBox>& neighbours, const AntennaOptions& o,
+                     const std::vector<registration::PoseCandidate>& previous) {
+  throw_unless_ok(o.Check(), "AntennaOptions");
+  // From one place the photos see the antenna along one line of sight: neither its points nor
+  // its outline fix its depth or its turn.
+  if (const double span = viewing_span(c.poses->views, rough_centre(m, model, c));
+      span < deg2rad(o.min_viewing_span_deg)) {
+    m.error = fmt::format(
+        "the photos see the antenna from nearly one place (their lines of sight to it span {:.1f}°, "
+        "at least {:.0f}° needed): take the photos while walking a few metres round it",
+        rad2deg(span), o.min_viewing_span_deg);
+    return;
+  }
+  if (!model) {
+    measure_model_free(m, c, o);
+  } else {
+    SceneObjects objects;
+    objects.board_box = board_box(c.board_spec, o);
+    objects.neighbours = neighbours;
+    objects.antenna_depth_m = depths_filling(model->size_m, rect_of(m.roi.roi), c.poses->intrinsics);
+    auto scene = registration_scene(*c.poses, c.up_board, m.region, m.region_view, rect_of(m.roi.roi), objects);
+    auto proposals = registration::propose_poses(*model, scene, o.registration, !previous.empty());
+    proposals.insert(proposals.end(), previous.begin(), previous.end());
+    auto r = registration::register_antenna(*model, scene, o.registration, proposals);
+    // A mast found beside the pose is known to a second registration of the same candidates.
+    if (r.found && o.mast)
+      if (auto mast = find_any_mast(m.region.cloud_board, r.T_board_antenna, model->size_m, c, objects, o)) {
+        objects.mast = m.mast = std::move(mast);
+        scene = registration_scene(*c.poses, c.up_board, m.region, m.region_view, rect_of(m.roi.roi), objects);
+        auto with_mast = registration::register_antenna(*model, scene, o.registration, r.candidates);
+        if (with_mast.found) r = std::move(with_mast);
+      }
+    if (!r.found) {
+      m.error = r.why_not;
+      return;
+    }
+    apply_registration(m, *model, r, c, o);
+    if (m.error) return;
+  }
+  m.attitude = antenna_attitude(*c.board, m.R_board_antenna, m.cov_board, *c.site);
+  if (!m.rivals_board.empty()) widen_for_rivals(m.attitude, m.R_board_antenna, m.rivals_board, *c.board, *c.site);
+}
+
+}  // namespace antpose::measure

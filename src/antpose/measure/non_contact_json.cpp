@@ -1,0 +1,150 @@
+// The JSON of `antpose measure` (docs/non-contact.md, *Output*).
+#include <cmath>
+
+#include <nlohmann/json.hpp>
+
+#include "antpose/io/report_text.hpp"
+#include "antpose/measure/non_contact.hpp"
+
+namespace antpose::measure {
+namespace {
+
+nlohmann::json deg_or_null(const std::optional<double>& rad) {
+  return rad ? nlohmann::json(rad2deg(*rad)) : nlohmann::json(nullptr);
+}
+
+nlohmann::json comparison_json(const std::optional<registration::Comparison>& c) {
+  if (!c) return nullptr;
+  return {{"difference", c->difference},
+          {"standard_error", c->standard_error},
+          {"units", c->units},
+          {"decisive", c->decisive}};
+}
+
+nlohmann::json board_json(const BoardWorldAttitude& b) {
+  return {{"R_world_board", io::matrix_rows_json(b.R_world_board)},
+          {"photos_used", b.used},
+          {"heading_scatter_deg", b.heading_scatter_deg},
+          {"compass_turn_deg", deg_or_null(b.compass_turn_rad)},
+          {"view_spread_deg", b.view_spread_deg},
+          {"heading_sigma_deg", rad2deg(std::sqrt(b.covariance(2, 2)))},
+          {"tilt_sigma_deg", rad2deg(std::sqrt((b.covariance(0, 0) + b.covariance(1, 1)) / 2))}};
+}
+
+nlohmann::json field_json(const FieldCheck& f) {
+  std::vector<double> dip_deg;
+  for (const double d : f.dip_rad) dip_deg.push_back(rad2deg(d));
+  nlohmann::json vectors = nlohmann::json::array(), positions = nlohmann::json::array();
+  for (const Vec3& b : f.field_world_uT) vectors.push_back({b.x(), b.y(), b.z()});
+  for (const Vec3& p : f.p_world_m) positions.push_back({p.x(), p.y(), p.z()});
+  return {{"field_world_uT", vectors},
+          {"position_world_m", positions},
+          {"strength_uT", f.strength_uT},
+          {"dip_deg", dip_deg},
+          {"wmm_strength_uT", f.wmm_strength_uT ? nlohmann::json(*f.wmm_strength_uT) : nullptr},
+          {"wmm_dip_deg", deg_or_null(f.wmm_dip_rad)},
+          {"strength_spread_percent", 100 * f.strength_spread_fraction},
+          {"dip_spread_deg", rad2deg(f.dip_spread_rad)},
+          {"strength_trend_percent", 100 * f.strength_trend_fraction},
+          {"strength_gradient_uT_per_m", f.strength_gradient_uT_per_m},
+          {"trend_f_statistic", f.trend_f_statistic},
+          {"vector_trend_percent", 100 * f.vector_trend_fraction},
+          {"vector_trend_f_statistic", f.vector_trend_f_statistic},
+          {"median_dip_offset_deg", f.wmm_dip_rad ? nlohmann::json(rad2deg(f.median_dip_offset_rad)) : nullptr},
+          {"disturbed", f.disturbed},
+          {"heading_sigma_deg", rad2deg(f.heading_sigma_rad)}};
+}
+
+nlohmann::json time_offset_json(const TimeOffsetCheck& t) {
+  return {{"device_s", t.device_s},
+          {"used_s", t.used_s},
+          {"checked", t.checked},
+          {"device_consistent", t.device_consistent},
+          {"consistent_s", {t.consistent_low_s, t.consistent_high_s}},
+          {"spread_at_device_deg", rad2deg(t.spread_at_device_rad)},
+          {"least_spread_deg", rad2deg(t.least_spread_rad)}};
+}
+
+nlohmann::json antenna_json(const AntennaMeasurement& m) {
+  nlohmann::json a;
+  a["roi"] = {{"image", m.roi.image},
+              {"x", m.roi.roi.x},
+              {"y", m.roi.roi.y},
+              {"width", m.roi.roi.width},
+              {"height", m.roi.roi.height}};
+  a["error"] = m.error ? nlohmann::json(*m.error) : nlohmann::json(nullptr);
+  const bool ok = !m.error;
+  const auto& at = m.attitude;
+  a["method"] = m.method;
+  a["verdict"] = registration::to_string(m.verdict);
+  a["azimuth_magnetic_deg"] = ok ? deg_or_null(at.magnetic.azimuth) : nullptr;
+  a["azimuth_true_deg"] = ok ? deg_or_null(at.azimuth_true) : nullptr;
+  a["downtilt_deg"] = ok ? nlohmann::json(rad2deg(at.magnetic.downtilt)) : nullptr;
+  a["roll_deg"] = ok ? deg_or_null(at.magnetic.roll) : nullptr;
+  a["uncertainty_deg"] = {{"azimuth", ok ? deg_or_null(at.sigma.azimuth) : nullptr},
+                          {"azimuth_true", ok ? deg_or_null(at.azimuth_true_sigma) : nullptr},
+                          {"downtilt", ok ? nlohmann::json(rad2deg(at.sigma.downtilt)) : nullptr},
+                          {"roll", ok ? deg_or_null(at.sigma.roll) : nullptr}};
+  a["fit_rmse_m"] = ok ? nlohmann::json(m.fit_rmse_m) : nullptr;
+  a["fitness"] = ok ? nlohmann::json(m.fitness) : nullptr;
+  nlohmann::json poses = nlohmann::json::array();
+  for (const auto& c : m.registration_candidates)
+    poses.push_back({{"strategy", c.strategy},
+                     {"score", c.score},
+                     {"R_board_antenna", io::matrix_rows_json(c.T_board_antenna.linear())},
+                     {"p_board_antenna_m",
+                      {c.T_board_antenna.translation().x(), c.T_board_antenna.translation().y(),
+                       c.T_board_antenna.translation().z()}}});
+  a["registration"] = {{"candidates", m.candidates},
+                       {"poses", poses},
+                       {"rivals", m.rivals_board.size()},
+                       {"runner_up", comparison_json(m.runner_up)},
+                       {"front_back", comparison_json(m.front_back)},
+                       {"front_back_cue", registration::to_string(m.front_back_cue)},
+                       {"edge_radius_m", m.edge_radius_m ? nlohmann::json(*m.edge_radius_m) : nullptr},
+                       {"edge_radii_within_m", m.edge_radii_within_m}};
+  if (m.mast)
+    a["mast"] = {{"axis_point_board_m",
+                  {m.mast->axis_point_board.x(), m.mast->axis_point_board.y(), m.mast->axis_point_board.z()}},
+                 {"radius_m", m.mast->radius_m},
+                 {"points", m.mast->points},
+                 {"photos", m.mast->views},
+                 {"edge_rms_px", m.mast->edge_rms_px}};
+  a["outline_rms_px"] = m.silhouette_rms_px ? nlohmann::json(*m.silhouette_rms_px) : nullptr;
+  a["photos_used"] = m.region.views_used;
+  a["points"] = m.region.cloud_board.size();
+  a["reconstruction"] = m.region.method;
+  if (ok) {
+    a["R_world_antenna"] = io::matrix_rows_json(at.R_world_antenna);
+    a["R_board_antenna"] = io::matrix_rows_json(m.R_board_antenna);
+  }
+  std::vector<std::string> warnings = ok ? at.warnings : std::vector<std::string>{};
+  warnings.insert(warnings.end(), m.warnings.begin(), m.warnings.end());
+  a["warnings"] = warnings;
+  return a;
+}
+
+}  // namespace
+
+nlohmann::json to_json(const NonContactResult& r) {
+  nlohmann::json j;
+  j["photos"] = r.photos.size();
+  j["photos_with_board"] = r.posed.size();
+  j["skipped"] = r.skipped;
+  j["photo_size_px"] = {r.intrinsics.width, r.intrinsics.height};
+  j["camera_poses"] = {{"board_rms_px", r.poses.board_rms_px},
+                       {"scene_rms_px", r.poses.scene_rms_px},
+                       {"tracks", r.poses.tracks},
+                       {"observations", r.poses.observations}};
+  j["time_offset"] = time_offset_json(r.time_offset);
+  j["board"] = board_json(r.board);
+  j["magnetic_field"] = field_json(r.field);
+  j["world"] = "enu-magnetic";
+  j["declination_deg"] = r.site ? nlohmann::json(rad2deg(r.site->declination)) : nlohmann::json(nullptr);
+  j["warnings"] = r.warnings;
+  j["antennas"] = nlohmann::json::array();
+  for (const auto& m : r.antennas) j["antennas"].push_back(antenna_json(m));
+  return j;
+}
+
+}  // namespace antpose::measure

@@ -1,0 +1,102 @@
+#include "antpose/registration/pose_selection.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <stdexcept>
+
+namespace antpose::registration {
+namespace {
+
+// Whether a mast stands clearly behind the pose: its boresight, across the mast's axis, within
+// `max_angle` of the direction from the axis to the panel's centre. nullopt where the mast cannot
+// tell (the panel beside it or on it, or side-on to it).
+std::optional<bool> faces_away_from(const reconstruction::Mast& mast, const Iso3& T_board_antenna, double max_angle) {
+  const Vec3 axis = mast.up_board.normalized();
+  const auto across = [&](const Vec3& v) -> Vec3 { return v - v.dot(axis) * axis; };
+  const Vec3 away = across(T_board_antenna.translation() - mast.axis_point_board);
+  const Vec3 boresight = across(T_board_antenna.linear().col(1));
+  if (away.norm() <= mast.radius_m || boresight.norm() < 1e-9) return std::nullopt;
+  const double cosine = away.normalized().dot(boresight.normalized());
+  if (cosine >= std::cos(max_angle)) return true;
+  if (cosine <= -std::cos(max_angle)) return false;
+  return std::nullopt;
+}
+
+}  // namespace
+
+std::string to_string(FrontBackCue cue) {
+  switch (cue) {
+    case FrontBackCue::kMast:
+      return "mast";
+    case FrontBackCue::kEvidence:
+      return "evidence";
+    case FrontBackCue::kNone:
+      break;
+  }
+  return "none";
+}
+
+Mat3 turned_round(const Mat3& R_board_antenna) { return R_board_antenna * Vec3(-1.0, -1.0, 1.0).asDiagonal(); }
+
+Iso3 turned_round(const Iso3& T_board_antenna) {
+  Iso3 T = T_board_antenna;
+  T.linear() = turned_round(T_board_antenna.linear());
+  return T;
+}
+
+double boresight_angle(const Mat3& a, const Mat3& b) { return angle_between(a.col(1), b.col(1)); }
+
+OptionProblems SelectionOptions::Check() const {
+  OptionProblems p;
+  p.require(rival_min_deg > 0 && rival_min_deg < 90, "rival_min_deg", "in (0, 90)");
+  p.require(mast_max_angle_deg > 0 && mast_max_angle_deg < 90, "mast_max_angle_deg", "in (0, 90)");
+  return p;
+}
+
+Selection select_pose(const std::vector<PoseCandidate>& candidates, const std::vector<PoseEvidence>& twins,
+                      const std::optional<reconstruction::Mast>& mast, const EvidenceOptions& evidence,
+                      const SelectionOptions& options) {
+  throw_unless_ok(options.Check(), "SelectionOptions");
+  if (candidates.empty() || twins.size() != candidates.size())
+    throw std::invalid_argument("select_pose: no candidates, or not one twin each");
+  Selection s;
+  std::vector<std::size_t> order(candidates.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(),
+            [&](std::size_t a, std::size_t b) { return candidates[a].score < candidates[b].score; });
+  s.best = order.front();
+  const Mat3& R_best = candidates[s.best].T_board_antenna.linear();
+  const double rival_min = deg2rad(options.rival_min_deg);
+  for (std::size_t k = 1; k < order.size(); ++k) {
+    const auto& c = candidates[order[k]];
+    const double angle = boresight_angle(c.T_board_antenna.linear(), R_best);
+    // Another answer: a boresight elsewhere, not just the winner turned round.
+    if (angle <= rival_min || angle >= M_PI - rival_min) continue;
+    const Comparison versus = compare_shape(candidates[s.best].evidence, c.evidence, evidence);
+    if (!s.runner_up) s.runner_up = versus;
+    if (!versus.decisive) s.rivals.push_back(order[k]);
+  }
+  // Front and back: the mast where it stands clearly behind one of the two, else the side units.
+  const Iso3& T = candidates[s.best].T_board_antenna;
+  if (mast)
+    if (const auto away = faces_away_from(*mast, T, deg2rad(options.mast_max_angle_deg))) {
+      s.turned = !*away;
+      s.front_back_cue = FrontBackCue::kMast;
+    }
+  const PoseEvidence& as_is = candidates[s.best].evidence;
+  const PoseEvidence& twin = twins[s.best];
+  if (s.front_back_cue == FrontBackCue::kNone) {
+    s.turned = twin.side_score(evidence) < as_is.side_score(evidence);
+    s.front_back = s.turned ? compare_side(twin, as_is, evidence) : compare_side(as_is, twin, evidence);
+    if (s.front_back.decisive)
+      s.front_back_cue = FrontBackCue::kEvidence;
+    else
+      s.front_back_open = true;
+  } else {
+    s.front_back = s.turned ? compare_side(twin, as_is, evidence) : compare_side(as_is, twin, evidence);
+  }
+  return s;
+}
+
+}  // namespace antpose::registration

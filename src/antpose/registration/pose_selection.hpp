@@ -1,0 +1,69 @@
+// Choosing an antenna's pose among candidates judged by the same evidence (pose_evidence.hpp).
+//
+// Shape first: the candidate with the lowest score wins; every other candidate whose boresight is
+// more than `rival_min_deg` from the winner's (its turned-round twin excepted: that is front and
+// back) and that the winner does not beat decisively is a rival — the photos and points do not
+// tell the two apart, and the answer must say so (a σ that covers both, or a refusal).
+// Then front and back, which the box's outline cannot tell: the winner against its twin turned
+// by 180° about its long axis. A known mast decides first where it stands clearly behind one of
+// them (a panel's back plate faces its mount); otherwise the side units (the vertical structure
+// on either side, the mount's points) decide where one side is decisively better; otherwise front
+// and back stay open.
+// No prior on the sign of the downtilt: panels with uptilt exist.
+#pragma once
+
+#include <cstddef>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "antpose/core/check.hpp"
+#include "antpose/reconstruction/mast.hpp"
+#include "antpose/registration/pose_evidence.hpp"
+
+namespace antpose::registration {
+
+/// One pose of the model with what the evidence says of it.
+struct PoseCandidate {
+  Iso3 T_board_antenna = Iso3::Identity();
+  std::string strategy;  // the strategy that proposed it (for reports)
+  PoseEvidence evidence;
+  double score = 1.0;  // evidence.score
+};
+
+struct SelectionOptions {
+  double rival_min_deg = 10.0;  // boresights closer than this are the same answer
+  /// The mast decides front and back where the boresight of one of the two lies within this of
+  /// the direction from the mast to the panel (the other then faces the mast).
+  double mast_max_angle_deg = 60.0;
+  OptionProblems Check() const;
+};
+
+enum class FrontBackCue { kNone, kMast, kEvidence };
+std::string to_string(FrontBackCue cue);  // "none", "mast", "evidence"
+
+struct Selection {
+  std::size_t best = 0;                 // index into the candidates; its twin turned round is not among them
+  bool turned = false;                  // the best's twin won front and back: use it turned round
+  std::vector<std::size_t> rivals;      // shape rivals, best first
+  std::optional<Comparison> runner_up;  // the best against the best distinct other candidate
+  FrontBackCue front_back_cue = FrontBackCue::kNone;
+  Comparison front_back;         // the chosen side against the other (side units)
+  bool front_back_open = false;  // no cue decided
+};
+
+/// `candidates` non-empty; `twins[i]` is candidate i's evidence turned round (same order).
+/// std::invalid_argument for empty or mismatched inputs.
+Selection select_pose(const std::vector<PoseCandidate>& candidates, const std::vector<PoseEvidence>& twins,
+                      const std::optional<reconstruction::Mast>& mast, const EvidenceOptions& evidence,
+                      const SelectionOptions& options);
+
+/// R_board_antenna turned by 180° about the antenna's own long axis: front and back swapped, the
+/// box's outline the same.
+Mat3 turned_round(const Mat3& R_board_antenna);
+Iso3 turned_round(const Iso3& T_board_antenna);
+
+/// The angle between two poses' boresights (y_a), rad.
+double boresight_angle(const Mat3& R_board_a, const Mat3& R_board_b);
+
+}  // namespace antpose::registration

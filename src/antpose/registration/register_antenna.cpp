@@ -1,0 +1,313 @@
+#include "antpose/registration/register_antenna.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+
+#include <fmt/format.h>
+#include <opencv2/core/utility.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "antpose/model/box_file.hpp"
+#include "antpose/model/sampling.hpp"
+
+namespace antpose::registration {
+namespace {
+
+struct Refined {
+  PoseCandidate candidate;
+  SilhouetteResult outline;
+  std::shared_ptr<const model::AntennaModel> model;  // refined with: the edge radius fitted, where it was
+  std::optional<EdgeRadiusFit> radius;
+};
+
+// Where the outline search starts the box's centre besides the rectangle's own fit: the region's
+// points' centroid.
+std::vector<Vec3> search_starts(const AntennaScene& s) {
+  if (s.points_board.empty()) return {};
+  return {centroid(s.points_board.points)};
+}
+
+std::vector<PoseCandidate> from_outline(const model::AntennaModel& model, const AntennaScene& s,
+                                        const RegisterOptions& o) {
+  OutlineSearchInput in;
+  in.box_size_m = model.size_m;
+  in.views = &s.views;
+  in.areas = s.areas;
+  in.region_view = s.region_view;
+  in.expected_width_px = std::max(8.0, std::min(s.roi.width, s.roi.height) / 1.1);
+  in.up_board = s.up_board;
+  in.starts_board = search_starts(s);
+  in.roi = s.roi;
+  in.min_roi_fill = o.min_roi_fill;
+  std::vector<PoseCandidate> out;
+  for (const auto& c : search_box_outline(in, s.intrinsics, o.search).candidates) {
+    if (out.size() >= o.refine_candidates) break;
+    out.push_back({c.T_board_antenna, "outline search", {}, c.cost});
+  }
+  return out;
+}
+
+std::vector<PoseCandidate> from_points(const model::AntennaModel& model, const AntennaScene& s,
+                                       const RegisterOptions& o) {
+  if (!o.points_start || s.points_board.size() < o.min_points_for_start) return {};
+  auto g = o.points;
+  g.viewpoints_scene = s.viewpoints_board;
+  const auto model_cloud = prepare(model::sample_surface(model.mesh_antenna, o.evidence.model_spacing_m, 1), g.fine);
+  const auto cloud = prepare(s.points_board, g.fine);
+  const auto start = global_align(cloud, model_cloud, s.up_board, g);
+  std::vector<PoseCandidate> out{{start.fit.T_target_source.inverse(), "points' global start", {}, 0.0}};
+  for (const auto& h : start.hypotheses) {
+    if (out.size() >= o.refine_candidates) break;
+    const Iso3 T = h.T_model_scene.inverse();
+    const bool apart = std::all_of(out.begin(), out.end(), [&](const PoseCandidate& c) {
+      return boresight_angle(c.T_board_antenna.linear(), T.linear()) > deg2rad(o.selection.rival_min_deg);
+    });
+    if (apart) out.push_back({T, "points' global start", {}, h.score()});
+  }
+  return out;
+}
+
+// The polish of refine_all: full resolution alone, ±fine_search_px.
+SilhouetteOptions polish_of(const SilhouetteOptions& descent) {
+  auto polish = descent;
+  polish.max_level = 0;
+  polish.search_range_px = polish.fine_search_px;
+  return polish;
+}
+
+// Each proposal descended by its outline (silhouette.hpp) with the model's box as the outline,
+// twice: through the pyramid from the coarse levels' wide search, and polished at full resolution
+// alone (±fine_search_px), which keeps a narrow panel in its own basin where the coarse levels
+// blur its edges into its neighbours'.
+std::vector<Refined> refine_all(const std::shared_ptr<const model::AntennaModel>& shared, const AntennaScene& s,
+                                const std::vector<PoseCandidate>& proposals, const RegisterOptions& o) {
+  const model::AntennaModel& model = *shared;
+  auto descent = o.refine;
+  descent.outline_box_m = model.size_m;
+  auto polish = polish_of(descent);
+  std::vector<Refined> out;
+  for (const auto& proposal : proposals)
+    for (const SilhouetteOptions* options : {&descent, &polish}) {
+      Refined& r = out.emplace_back();
+      r.outline = refine_by_silhouette(model.mesh_antenna, proposal.T_board_antenna, s.views, s.intrinsics, *options);
+      r.candidate = proposal;
+      r.candidate.T_board_antenna = r.outline.T_board_antenna;
+      r.model = shared;
+    }
+  return out;
+}
+
+// The box's orientation angle, its own half-turn about the long axis allowed.
+double box_angle(const Mat3& a, const Mat3& b) {
+  return std::min(rotation_distance(a, b), rotation_distance(a, turned_round(b)));
+}
+
+// Refined candidates that fit the rectangle, one per place: of those ending at the same box pose,
+// the one whose outline fits best. Best outline first.
+std::vector<Refined> distinct_in_rectangle(std::vector<Refined> refined, const model::AntennaModel& model,
+                                           const AntennaScene& s, const RegisterOptions& o) {
+  std::sort(refined.begin(), refined.end(),
+            [](const Refined& a, const Refined& b) { return a.outline.score < b.outline.score; });
+  std::vector<Refined> out;
+  for (auto& r : refined) {
+    const Iso3& T = r.candidate.T_board_antenna;
+    const auto [fill, centred] = roi_fill(model.size_m, T, s.views[s.region_view], s.intrinsics, s.roi);
+    if (fill < o.min_roi_fill || !centred) continue;
+    const bool known = std::any_of(out.begin(), out.end(), [&](const Refined& k) {
+      const Iso3& U = k.candidate.T_board_antenna;
+      return rad2deg(box_angle(T.linear(), U.linear())) < o.same_pose_deg &&
+             (T.translation() - U.translation()).norm() < o.same_pose_m;
+    });
+    if (!known) out.push_back(std::move(r));
+  }
+  return out;
+}
+
+// The best candidates' edge rounding profiled with their poses (shape_fit.hpp): each then carries
+// its best radius's pose, outline and model. Before any judgement of the outline: fitted with the
+// wrong rounding, even the right pose may fit its outline poorly.
+void fit_shapes(std::vector<Refined>& kept, const AntennaScene& s, const RegisterOptions& o) {
+  for (std::size_t i = 0; i < std::min(kept.size(), o.shape_candidates); ++i) {
+    auto& k = kept[i];
+    auto fit = fit_edge_radius(*k.model, k.candidate.T_board_antenna, s.views, s.intrinsics, polish_of(o.refine),
+                               o.evidence, o.edge_radius);
+    if (!fit.fitted || fit.outline.score >= k.outline.score) continue;
+    k.outline = fit.outline;
+    k.candidate.T_board_antenna = fit.outline.T_board_antenna;
+    k.model = std::make_shared<const model::AntennaModel>(fit.model);
+    k.radius = std::move(fit);
+  }
+}
+
+// The candidates whose outline meets the photos' edges (max_outline_score, min_outline_views).
+void keep_fitting_outlines(std::vector<Refined>& kept, const RegisterOptions& o) {
+  std::erase_if(kept, [&](const Refined& k) {
+    return k.outline.score > o.max_outline_score || k.outline.views_used < o.min_outline_views;
+  });
+}
+
+// A rival's pose turned the way the result's front and back were decided: by the mast where it
+// decided them, else facing within 90° of the result.
+Iso3 rival_facing(const Iso3& rival, const Iso3& result) {
+  return boresight_angle(rival.linear(), result.linear()) <= M_PI / 2 ? rival : turned_round(rival);
+}
+
+// The vertical structure behind and before the candidate (reconstruction/mast_search.hpp) as side
+// units of its evidence and its twin's: behind the twin is before the candidate.
+void add_mount_outline(PoseEvidence& as_is, PoseEvidence& twin, const Refined& k, const AntennaScene& s,
+                       const RegisterOptions& o) {
+  std::vector<reconstruction::PosedView> views;
+  std::vector<std::vector<std::vector<cv::Point2f>>> occluders;
+  for (const auto& v : s.views) {
+    reconstruction::PosedView& pv = views.emplace_back();
+    pv.image = v.image, pv.R_camera_board = v.R_camera_board, pv.t_camera_board = v.t_camera_board;
+    auto& here = occluders.emplace_back(v.occluders);
+    std::vector<cv::Point2f> corners, hull;
+    for (const Vec3& c : model::box_corners(k.model->size_m))
+      if (const auto uv = s.intrinsics.project(v.R_camera_board * (k.candidate.T_board_antenna * c) + v.t_camera_board))
+        corners.emplace_back(static_cast<float>(uv->x()), static_cast<float>(uv->y()));
+    if (corners.size() == 8) cv::convexHull(corners, hull), here.push_back(hull);
+  }
+  const auto sides = reconstruction::search_mount_sides(views, s.intrinsics, s.up_board, k.candidate.T_board_antenna,
+                                                        k.model->size_m, occluders, o.mount_search);
+  if (!sides.behind || !sides.before) return;
+  as_is.mount_outline = sides.behind->view_costs;
+  twin.mount_outline = sides.before->view_costs;
+}
+
+// Each candidate judged with its own model (pose_evidence.hpp), and the selection
+// (pose_selection.hpp); the best's front and back also by the vertical structure on its sides.
+AntennaRegistration select(const AntennaScene& s, std::vector<Refined> kept, const RegisterOptions& o) {
+  EvidenceScene scene{&s.views, s.intrinsics, &s.points_board, s.viewpoints_board, s.up_board};
+  std::vector<PoseCandidate> candidates;
+  std::vector<PoseEvidence> twins;
+  for (auto& k : kept) {
+    const EvidenceJudge judge(*k.model, scene, o.evidence);
+    candidates.push_back(k.candidate);
+    candidates.back().evidence = judge(k.candidate.T_board_antenna);
+    candidates.back().score = candidates.back().evidence.score(judge.options());
+    twins.push_back(judge(turned_round(k.candidate.T_board_antenna)));
+  }
+  const auto best_shape = static_cast<std::size_t>(
+      std::min_element(candidates.begin(), candidates.end(),
+                       [](const PoseCandidate& a, const PoseCandidate& b) { return a.score < b.score; }) -
+      candidates.begin());
+  add_mount_outline(candidates[best_shape].evidence, twins[best_shape], kept[best_shape], s, o);
+  AntennaRegistration out;
+  out.found = true;
+  out.selection = select_pose(candidates, twins, s.mast, o.evidence, o.selection);
+  const auto& sel = out.selection;
+  Refined& best = kept[sel.best];
+  out.T_board_antenna = sel.turned ? turned_round(best.candidate.T_board_antenna) : best.candidate.T_board_antenna;
+  out.rotation_covariance_board = best.outline.covariance.topLeftCorner<3, 3>();
+  if (best.radius) out.rotation_covariance_board += best.radius->spread_board;
+  out.dilation_yaw_sigma_rad = best.outline.dilation_yaw_sigma_rad;
+  out.outline_score = best.outline.score, out.outline_rms_px = best.outline.rms_px;
+  out.outline_views = best.outline.views_used;
+  out.edge_radius = std::move(best.radius);
+  for (const auto i : sel.rivals)
+    out.rivals.push_back(rival_facing(candidates[i].T_board_antenna, out.T_board_antenna));
+  if (sel.front_back_open) out.rivals.push_back(turned_round(out.T_board_antenna));
+  out.verdict = !sel.rivals.empty()   ? RegistrationVerdict::kAmbiguousShape
+                : sel.front_back_open ? RegistrationVerdict::kFrontBackOpen
+                                      : RegistrationVerdict::kUnique;
+  out.candidates = std::move(candidates);
+  return out;
+}
+
+void check_scene(const AntennaScene& s) {
+  if (s.views.empty() || s.region_view >= s.views.size() || s.areas.size() != s.views.size() ||
+      s.viewpoints_board.size() != s.views.size())
+    throw std::invalid_argument(
+        "register_antenna: no views, a region view out of range, or not one area and viewpoint per view");
+}
+
+}  // namespace
+
+std::string to_string(RegistrationVerdict verdict) {
+  switch (verdict) {
+    case RegistrationVerdict::kAmbiguousShape:
+      return "ambiguous";
+    case RegistrationVerdict::kFrontBackOpen:
+      return "front-back-open";
+    case RegistrationVerdict::kUnique:
+      break;
+  }
+  return "unique";
+}
+
+OptionProblems RegisterOptions::Check() const {
+  OptionProblems p;
+  p.nest("search", search.Check());
+  p.nest("evidence", evidence.Check());
+  p.nest("selection", selection.Check());
+  p.nest("edge_radius", edge_radius.Check());
+  p.nest("mount_search", mount_search.Check());
+  p.require(refine_candidates >= 1, "refine_candidates", "at least 1");
+  p.require(same_pose_deg >= 0 && same_pose_m >= 0, "same_pose_deg, same_pose_m", "≥ 0");
+  p.require(min_roi_fill >= 0 && min_roi_fill <= 1, "min_roi_fill", "in [0, 1]");
+  p.require(max_outline_score > 0 && max_outline_score <= 1, "max_outline_score", "in (0, 1]");
+  return p;
+}
+
+std::pair<double, bool> roi_fill(const Vec3& size_m, const Iso3& T_board_antenna, const SilhouetteView& view,
+                                 const camera::CameraIntrinsics& K, const cv::Rect& roi) {
+  Eigen::AlignedBox2d box;
+  for (const Vec3& corner : model::box_corners(size_m)) {
+    const auto uv = K.project(view.R_camera_board * (T_board_antenna * corner) + view.t_camera_board);
+    if (!uv) return {0.0, false};
+    box.extend(*uv);
+  }
+  const Eigen::AlignedBox2d rect(Vec2(roi.x - 0.5, roi.y - 0.5),
+                                 Vec2(roi.x + roi.width - 0.5, roi.y + roi.height - 0.5));
+  const Eigen::AlignedBox2d cut = box.intersection(rect);
+  return {cut.isEmpty() ? 0.0 : cut.volume() / rect.volume(), rect.contains(box.center())};
+}
+
+std::vector<PoseCandidate> propose_poses(const model::AntennaModel& model, const AntennaScene& s,
+                                         const RegisterOptions& o, bool outline_only) {
+  throw_unless_ok(o.Check(), "RegisterOptions");
+  check_scene(s);
+  auto proposals = from_outline(model, s, o);
+  if (outline_only) return proposals;
+  const auto by_points = from_points(model, s, o);
+  proposals.insert(proposals.end(), by_points.begin(), by_points.end());
+  return proposals;
+}
+
+AntennaRegistration register_antenna(const model::AntennaModel& model, const AntennaScene& s,
+                                     const RegisterOptions& o) {
+  return register_antenna(model, s, o, propose_poses(model, s, o));
+}
+
+AntennaRegistration register_antenna(const model::AntennaModel& model, const AntennaScene& s, const RegisterOptions& o,
+                                     const std::vector<PoseCandidate>& proposals) {
+  throw_unless_ok(o.Check(), "RegisterOptions");
+  check_scene(s);
+  const auto shared = std::make_shared<const model::AntennaModel>(model);
+  auto kept = distinct_in_rectangle(refine_all(shared, s, proposals, o), model, s, o);
+  fit_shapes(kept, s, o);
+  keep_fitting_outlines(kept, o);
+  if (kept.empty()) {
+    AntennaRegistration none;
+    none.proposed = proposals.size();
+    none.why_not =
+        proposals.empty()
+            ? fmt::format(
+                  "nothing in the rectangle fits the outline of the model '{}' in the photos: is the rectangle "
+                  "drawn around the antenna, and is the model this antenna's?",
+                  model.name)
+            : fmt::format(
+                  "no pose of the model '{}' fits its outline in the photos and fills the rectangle ({} "
+                  "tried): is the rectangle drawn closely around the whole antenna, and is the model this "
+                  "antenna's?",
+                  model.name, proposals.size());
+    return none;
+  }
+  auto out = select(s, std::move(kept), o);
+  out.proposed = proposals.size();
+  return out;
+}
+
+}  // namespace antpose::registration

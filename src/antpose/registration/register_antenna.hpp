@@ -1,0 +1,123 @@
+// The registration of one antenna model to its region (docs/non-contact.md, *Registration*):
+//
+//   strategies ──► candidate poses ──► each refined by its outline in every photo
+//   (outline search: outline_search.hpp;          (silhouette.hpp); the best ones' edge rounding
+//    the points' global start: global_start.hpp)   profiled with their pose (shape_fit.hpp)
+//                                                         │
+//                                    evidence of each and of each turned round (pose_evidence.hpp)
+//                                                         │
+//                      selection: the best shape, its rivals, front and back (pose_selection.hpp)
+//
+// A candidate must fit the user's rectangle: its box, projected into the rectangle's photo, covers
+// at least `min_roi_fill` of it and has its centre inside it (the rectangle was drawn around this
+// antenna, so a pose on a neighbour or the mast does not qualify); and its outline must meet the
+// photos' edges (max_outline_score, min_outline_views). "Not found" is a value: the
+// result says why and what photo or rectangle would help.
+#pragma once
+
+#include <cstddef>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "antpose/core/check.hpp"
+#include "antpose/model/antenna_model.hpp"
+#include "antpose/reconstruction/mast.hpp"
+#include "antpose/reconstruction/mast_search.hpp"
+#include "antpose/registration/global_start.hpp"
+#include "antpose/registration/outline_search.hpp"
+#include "antpose/registration/pose_evidence.hpp"
+#include "antpose/registration/pose_selection.hpp"
+#include "antpose/registration/shape_fit.hpp"
+#include "antpose/registration/silhouette.hpp"
+
+namespace antpose::registration {
+
+/// What one antenna's registration sees, board frame.
+struct AntennaScene {
+  std::vector<SilhouetteView> views;  // the photos, with known objects (board, mast, neighbours)
+  camera::CameraIntrinsics intrinsics;
+  std::vector<Vec3> viewpoints_board;  // camera centres, one per view
+  Vec3 up_board = Vec3::UnitZ();
+  PointCloud points_board;                     // the region's points, normals towards the cameras
+  std::size_t region_view = 0;                 // the photo the rectangle is drawn in
+  cv::Rect roi;                                // the rectangle (px)
+  std::vector<std::optional<cv::Rect>> areas;  // per view, where the antenna may show (px)
+  std::optional<reconstruction::Mast> mast;    // a mast known beside it
+};
+
+struct RegisterOptions {
+  OutlineSearchOptions search;
+  bool points_start = true;  // the points' global start as a second strategy (where there are points)
+  GlobalStartOptions points;
+  std::size_t min_points_for_start = 200;
+  std::size_t refine_candidates = 6;  // of each strategy, best first
+  /// The refinement: no restarts of its own (the strategies span the yaws), a trust region on the
+  /// rotation, and a neighbour or the mast may hide part of the outline.
+  SilhouetteOptions refine = [] {
+    SilhouetteOptions o;
+    o.rival_yaw_offsets_rad.clear();
+    o.min_inlier_fraction = 0.35;
+    o.max_rotation_change_rad = deg2rad(20.0);
+    return o;
+  }();
+  EvidenceOptions evidence;
+  SelectionOptions selection;
+  EdgeRadiusOptions edge_radius;                   // the best candidates' edge rounding profiled (shape_fit.hpp)
+  reconstruction::MastSearchOptions mount_search;  // vertical structure behind and before the best
+  std::size_t shape_candidates = 3;                // that many, by their outline
+  double same_pose_deg = 2.0, same_pose_m = 0.03;  // refined candidates this close are one
+  double min_roi_fill = 0.3;
+  /// A pose whose outline misses its edges this much (SilhouetteResult::score: half of the outline
+  /// without an edge within the cutoff scores 0.5) in fewer than `min_outline_views` photos fits
+  /// no object: a rectangle on the sky, or the wrong model.
+  double max_outline_score = 0.5;
+  std::size_t min_outline_views = 3;
+  OptionProblems Check() const;
+};
+
+enum class RegistrationVerdict {
+  kUnique,          // one pose, front and back decided
+  kAmbiguousShape,  // another pose fits about as well (rivals)
+  kFrontBackOpen,   // front and back undecided
+};
+std::string to_string(RegistrationVerdict verdict);  // "unique", "ambiguous", "front-back-open"
+
+struct AntennaRegistration {
+  bool found = false;
+  std::string why_not;  // when not found: why, and what would help
+  Iso3 T_board_antenna = Iso3::Identity();
+  Mat3 rotation_covariance_board = Mat3::Zero();  // rad², the outline's at the pose (and the edge radius's)
+  std::optional<EdgeRadiusFit> edge_radius;       // where the model's rounding was refitted
+  double dilation_yaw_sigma_rad = 0.0;            // SilhouetteResult's
+  double outline_score = 1.0, outline_rms_px = 0.0;
+  std::size_t outline_views = 0;
+  RegistrationVerdict verdict = RegistrationVerdict::kUnique;
+  std::vector<Iso3> rivals;  // other poses the evidence does not rule out (front and back as decided)
+  Selection selection;
+  std::vector<PoseCandidate> candidates;  // refined, distinct, with their evidence
+  std::size_t proposed = 0;               // candidates the strategies proposed
+  std::vector<std::string> warnings;
+};
+
+/// The strategies' proposals (the outline search; the points' global start unless `outline_only`),
+/// best of each first.
+std::vector<PoseCandidate> propose_poses(const model::AntennaModel& model, const AntennaScene& scene,
+                                         const RegisterOptions& options, bool outline_only = false);
+
+/// The proposals refined, judged and selected. A second registration of the same antenna in a
+/// scene that knows more (a mast, neighbours) passes the first one's candidates as proposals.
+AntennaRegistration register_antenna(const model::AntennaModel& model, const AntennaScene& scene,
+                                     const RegisterOptions& options, const std::vector<PoseCandidate>& proposals);
+
+/// propose_poses, then the above.
+AntennaRegistration register_antenna(const model::AntennaModel& model, const AntennaScene& scene,
+                                     const RegisterOptions& options);
+
+/// Share of `roi` that the model's box at `T_board_antenna`, projected into `view`, covers (its
+/// projected corners' bounding box cut to the rectangle), and whether that box's centre lies in
+/// the rectangle. {0, false} where a corner is behind the camera.
+std::pair<double, bool> roi_fill(const Vec3& size_m, const Iso3& T_board_antenna, const SilhouetteView& view,
+                                 const camera::CameraIntrinsics& intrinsics, const cv::Rect& roi);
+
+}  // namespace antpose::registration

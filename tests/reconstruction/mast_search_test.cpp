@@ -1,0 +1,70 @@
+#include "antpose/reconstruction/mast_search.hpp"
+
+#include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
+
+#include "antpose/model/box_file.hpp"
+#include "registration/panel_scene.hpp"
+
+namespace antpose::reconstruction {
+namespace {
+
+using registration::fixture::SyntheticScene;
+
+struct Inputs {
+  std::vector<PosedView> views;
+  std::vector<std::vector<std::vector<cv::Point2f>>> occluders;  // the panel, in every photo
+};
+
+Inputs inputs(const SyntheticScene& s, const Vec3& size) {
+  Inputs in;
+  for (const auto& v : s.views) {
+    PosedView& p = in.views.emplace_back();
+    p.image = v.image, p.R_camera_board = v.R_camera_board, p.t_camera_board = v.t_camera_board;
+    std::vector<cv::Point2f> corners, hull;
+    for (const Vec3& c : model::box_corners(size)) {
+      const auto uv = *s.intrinsics.project(v.R_camera_board * (s.T_board_antenna * c) + v.t_camera_board);
+      corners.emplace_back(static_cast<float>(uv.x()), static_cast<float>(uv.y()));
+    }
+    cv::convexHull(corners, hull);
+    in.occluders.push_back({hull});
+  }
+  return in;
+}
+
+// The fixture's pole stands 0.35 m behind the panel and has no texture at all.
+TEST(MastSearch, APlainPoleIsFoundByItsOutlineAlone) {
+  const SyntheticScene s = registration::fixture::make_scene();
+  const Vec3 size = model::parametric_panel({}).size_m;
+  const Inputs in = inputs(s, size);
+  const auto mast =
+      find_mast_by_outline(in.views, s.intrinsics, s.mast.up_board, s.T_board_antenna, size, in.occluders, {});
+  ASSERT_TRUE(mast);
+  const Vec3 d = mast->axis_point_board - s.mast.axis_point_board;
+  EXPECT_LT((d - d.dot(s.mast.up_board) * s.mast.up_board).norm(), 0.03);
+  EXPECT_NEAR(mast->radius_m, s.mast.radius_m, 0.01);
+}
+
+TEST(MastSearch, TheStructureBehindThePanelFitsBetterThanAnyBeforeIt) {
+  const SyntheticScene s = registration::fixture::make_scene();
+  const Vec3 size = model::parametric_panel({}).size_m;
+  const Inputs in = inputs(s, size);
+  const auto sides =
+      search_mount_sides(in.views, s.intrinsics, s.mast.up_board, s.T_board_antenna, size, in.occluders, {});
+  ASSERT_TRUE(sides.behind && sides.before);
+  EXPECT_LT(sides.behind->cost + 0.2, sides.before->cost);
+  int better = 0;
+  for (std::size_t i = 0; i < in.views.size(); ++i)
+    better += sides.behind->view_costs[i] < sides.before->view_costs[i] ? 1 : 0;
+  EXPECT_GE(better, static_cast<int>(in.views.size()) - 1);
+}
+
+TEST(MastSearch, ChecksItsOptions) {
+  MastSearchOptions o;
+  o.step_m = 0.0;
+  EXPECT_THROW(find_mast_by_outline({}, {}, Vec3::UnitZ(), Iso3::Identity(), Vec3::Ones(), {}, o),
+               std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace antpose::reconstruction

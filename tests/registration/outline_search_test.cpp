@@ -1,0 +1,75 @@
+#include "antpose/registration/outline_search.hpp"
+
+#include <gtest/gtest.h>
+
+#include "antpose/model/box_file.hpp"
+#include "antpose/registration/pose_selection.hpp"
+#include "registration/panel_scene.hpp"
+
+namespace antpose::registration {
+namespace {
+
+using fixture::make_scene;
+using fixture::SyntheticScene;
+
+// The box's orientation error, its half-turn about the long axis allowed (the outline's symmetry).
+double box_error_deg(const Mat3& R, const Mat3& R_true) {
+  return rad2deg(std::min(rotation_distance(R, R_true), rotation_distance(turned_round(R), R_true)));
+}
+
+// The projected box's bounding rectangle in a view, widened by `margin` of its size (a user's).
+cv::Rect rectangle_around(const SyntheticScene& s, std::size_t view, const Vec3& size, double margin) {
+  Eigen::AlignedBox2d box;
+  for (const Vec3& c : model::box_corners(size))
+    box.extend(
+        *s.intrinsics.project(s.views[view].R_camera_board * (s.T_board_antenna * c) + s.views[view].t_camera_board));
+  const Vec2 grow = margin * box.sizes();
+  return {static_cast<int>(box.min().x() - grow.x()), static_cast<int>(box.min().y() - grow.y()),
+          static_cast<int>(box.sizes().x() + 2 * grow.x()), static_cast<int>(box.sizes().y() + 2 * grow.y())};
+}
+
+OutlineSearchInput input_for(const SyntheticScene& s, const Vec3& size, const Vec3& start) {
+  OutlineSearchInput in;
+  in.box_size_m = size;
+  in.views = &s.views;
+  for (std::size_t v = 0; v < s.views.size(); ++v) {
+    const cv::Rect r = rectangle_around(s, v, size, 0.3);
+    in.areas.emplace_back(r);
+  }
+  in.region_view = 3;
+  in.expected_width_px = rectangle_around(s, 3, size, 0.0).width;
+  in.up_board = s.mast.up_board;
+  in.starts_board = {start};
+  return in;
+}
+
+TEST(OutlineSearch, FindsThePanelFromAFarStartWithoutTexture) {
+  const SyntheticScene s = make_scene();
+  const Vec3 size = model::parametric_panel({}).size_m;
+  // A start 0.25 m off the panel's centre, as a rectangle's depth guess may be.
+  const Vec3 start = s.T_board_antenna.translation() + Vec3(0.15, -0.1, 0.17);
+  const auto result = search_box_outline(input_for(s, size, start), s.intrinsics, {});
+  ASSERT_FALSE(result.candidates.empty());
+  const auto& best = result.candidates.front();
+  EXPECT_LT(box_error_deg(best.T_board_antenna.linear(), s.T_board_antenna.linear()), 6.0);
+  EXPECT_LT((best.T_board_antenna.translation() - s.T_board_antenna.translation()).norm(), 0.06);
+  EXPECT_EQ(best.views, s.views.size());
+  EXPECT_LT(best.cost, 0.3);
+  // The rest lie elsewhere or at other orientations, and fit worse.
+  for (std::size_t k = 1; k < result.candidates.size(); ++k) EXPECT_GE(result.candidates[k].cost, best.cost);
+}
+
+TEST(OutlineSearch, ChecksItsOptionsAndInputs) {
+  OutlineSearchOptions o;
+  o.yaw_step_deg = 0;
+  o.tilt_deg.clear();
+  EXPECT_FALSE(o.Check().ok());
+  EXPECT_NE(o.Check().message().find("yaw_step_deg"), std::string::npos);
+  const SyntheticScene s = make_scene();
+  OutlineSearchInput in = input_for(s, Vec3(0.3, 0.16, 1.31), s.T_board_antenna.translation());
+  in.region_view = 99;
+  EXPECT_THROW(search_box_outline(in, s.intrinsics, {}), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace antpose::registration

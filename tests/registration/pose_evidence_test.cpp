@@ -1,0 +1,92 @@
+#include "antpose/registration/pose_evidence.hpp"
+
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "antpose/camera/board_pose.hpp"
+#include "antpose/model/sampling.hpp"
+#include "antpose/registration/pose_selection.hpp"
+#include "registration/panel_scene.hpp"
+
+namespace antpose::registration {
+namespace {
+
+using fixture::make_scene;
+using fixture::SyntheticScene;
+
+PoseEvidence with_outline(std::vector<double> outline) {
+  PoseEvidence e;
+  e.outline = std::move(outline);
+  return e;
+}
+
+TEST(PoseEvidence, ADifferenceThePhotosAgreeOnIsDecisive) {
+  const EvidenceOptions o;
+  const auto better = with_outline({0.10, 0.12, 0.09, 0.11, 0.10, 0.13, 0.12, 0.10});
+  const auto worse = with_outline({0.18, 0.19, 0.17, 0.20, 0.18, 0.21, 0.19, 0.18});
+  const Comparison c = compare_shape(better, worse, o);
+  EXPECT_NEAR(c.difference, 0.07875, 1e-9);
+  EXPECT_EQ(c.units, 8u);
+  EXPECT_TRUE(c.decisive);
+}
+
+TEST(PoseEvidence, ADifferenceOnePhotoMakesIsNot) {
+  const EvidenceOptions o;
+  // The same mean difference, all of it from one photo (a clutter edge there).
+  const auto better = with_outline({0.10, 0.12, 0.09, 0.11, 0.10, 0.13, 0.12, 0.10});
+  auto one = better.outline;
+  one[3] += 0.65;
+  const Comparison c = compare_shape(better, with_outline(one), o);
+  EXPECT_NEAR(c.difference, 0.08125, 1e-9);
+  EXPECT_FALSE(c.decisive);
+  // And a tie is never decisive, however consistent.
+  auto tie = better.outline;
+  for (double& v : tie) v += 0.005;
+  EXPECT_FALSE(compare_shape(better, with_outline(tie), o).decisive);
+}
+
+TEST(PoseEvidence, UnitsEitherPoseLacksDoNotEnter) {
+  const EvidenceOptions o;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const Comparison c = compare_shape(with_outline({0.1, nan, 0.1}), with_outline({0.3, 0.3, nan}), o);
+  EXPECT_EQ(c.units, 1u);
+  EXPECT_FALSE(c.decisive) << "one unit alone cannot be decisive";
+}
+
+// The fixture's panel with points on what the cameras see of it, 5 mm noise.
+PointCloud seen_points(const SyntheticScene& s) {
+  const auto model = model::parametric_panel({});
+  std::vector<Vec3> viewpoints_antenna;
+  const Iso3 T_antenna_board = s.T_board_antenna.inverse();
+  for (const auto& v : s.views)
+    viewpoints_antenna.push_back(T_antenna_board * camera::camera_centre(v.R_camera_board, v.t_camera_board));
+  PointCloud cloud =
+      transformed(model::visible_surface(model.mesh_antenna, viewpoints_antenna, 0.02, 5), s.T_board_antenna);
+  std::mt19937_64 rng(9);
+  std::normal_distribution<double> n(0.0, 0.005);
+  for (Vec3& p : cloud.points) p += Vec3(n(rng), n(rng), n(rng));
+  return cloud;
+}
+
+TEST(PoseEvidence, TheTruePoseBeatsAnotherYawDecisively) {
+  const SyntheticScene s = make_scene();
+  const auto model = model::parametric_panel({});
+  const PointCloud points = seen_points(s);
+  EvidenceScene scene{&s.views, s.intrinsics, &points, {}, s.mast.up_board};
+  for (const auto& v : s.views)
+    scene.viewpoints_board.push_back(camera::camera_centre(v.R_camera_board, v.t_camera_board));
+  const EvidenceJudge judge(model, scene, {});
+  const PoseEvidence truth = judge(s.T_board_antenna);
+  Iso3 yawed = s.T_board_antenna;
+  yawed.linear() = Eigen::AngleAxisd(deg2rad(25.0), s.T_board_antenna.linear().col(2)) * yawed.linear();
+  const PoseEvidence other = judge(yawed);
+  EXPECT_LT(truth.score(judge.options()), other.score(judge.options()));
+  EXPECT_TRUE(compare_shape(truth, other, judge.options()).decisive);
+  // Turned round, the box's outline is the same: the shape units barely differ.
+  const PoseEvidence turned = judge(turned_round(s.T_board_antenna));
+  EXPECT_FALSE(compare_shape(truth, turned, judge.options()).decisive);
+}
+
+}  // namespace
+}  // namespace antpose::registration

@@ -1,0 +1,67 @@
+#include "antpose/registration/pose_selection.hpp"
+
+#include <gtest/gtest.h>
+
+namespace antpose::registration {
+namespace {
+
+// A candidate facing `azimuth_deg` about the board's z (up), at `p`, with given outline costs.
+PoseCandidate facing(double azimuth_deg, const Vec3& p, std::vector<double> outline) {
+  PoseCandidate c;
+  c.T_board_antenna = isometry(rot_z(-deg2rad(azimuth_deg)), p);
+  c.evidence.outline = std::move(outline);
+  c.score = c.evidence.score({});
+  return c;
+}
+
+// Side units: the outline cost of the vertical structure behind the pose, photo by photo.
+PoseEvidence side(std::vector<double> mount_outline) {
+  PoseEvidence e;
+  e.mount_outline = std::move(mount_outline);
+  return e;
+}
+
+TEST(PoseSelection, AnotherYawThePhotosDoNotRuleOutIsARival) {
+  const std::vector<PoseCandidate> candidates{
+      facing(40, Vec3::Zero(), {0.10, 0.11, 0.09, 0.10, 0.12, 0.10}),
+      facing(75, Vec3::Zero(), {0.09, 0.16, 0.10, 0.13, 0.10, 0.14}),    // about as good: a rival
+      facing(130, Vec3::Zero(), {0.30, 0.32, 0.29, 0.31, 0.33, 0.30}),   // clearly worse
+      facing(222, Vec3::Zero(), {0.10, 0.11, 0.09, 0.10, 0.12, 0.10})};  // the best turned round: not a rival
+  const std::vector<PoseEvidence> twins(candidates.size(), side({0.0, 0.0}));
+  const Selection s = select_pose(candidates, twins, std::nullopt, {}, {});
+  EXPECT_EQ(s.best, 0u);
+  ASSERT_EQ(s.rivals.size(), 1u);
+  EXPECT_EQ(s.rivals[0], 1u);
+  ASSERT_TRUE(s.runner_up);
+  EXPECT_FALSE(s.runner_up->decisive);
+}
+
+TEST(PoseSelection, AMastBehindDecidesFrontAndBackWhateverTheDowntilt) {
+  // The panel 0.4 m north of the mast; as registered it faces south, at its mast: turned round
+  // it faces north, away from it. An uptilt as registered changes nothing.
+  reconstruction::Mast mast;
+  mast.axis_point_board = Vec3::Zero(), mast.up_board = Vec3::UnitZ(), mast.radius_m = 0.06;
+  PoseCandidate c = facing(180, Vec3(0.0, 0.4, 0.0), {0.1, 0.1});
+  c.T_board_antenna.linear() = c.T_board_antenna.linear() * rot_x(deg2rad(8.0));
+  const Selection s = select_pose({c}, {side({0.0, 0.0})}, mast, {}, {});
+  EXPECT_TRUE(s.turned);
+  EXPECT_EQ(s.front_back_cue, FrontBackCue::kMast);
+  EXPECT_FALSE(s.front_back_open);
+}
+
+TEST(PoseSelection, WithoutACueFrontAndBackStayOpen) {
+  PoseCandidate c = facing(10, Vec3::Zero(), {0.1, 0.1, 0.1});
+  c.evidence.mount_outline = {0.32, 0.30, 0.33};
+  // Turned round, a structure behind fits about as well in some photos and worse in others.
+  const Selection open = select_pose({c}, {side({0.30, 0.35, 0.31})}, std::nullopt, {}, {});
+  EXPECT_TRUE(open.front_back_open);
+  EXPECT_EQ(open.front_back_cue, FrontBackCue::kNone);
+  // Where every photo shows a pole behind the pose and none behind its twin, the evidence decides.
+  const Selection decided = select_pose({c}, {side({0.60, 0.62, 0.65})}, std::nullopt, {}, {});
+  EXPECT_FALSE(decided.front_back_open);
+  EXPECT_FALSE(decided.turned);
+  EXPECT_EQ(decided.front_back_cue, FrontBackCue::kEvidence);
+}
+
+}  // namespace
+}  // namespace antpose::registration

@@ -1,0 +1,95 @@
+#include "antpose/registration/register_antenna.hpp"
+
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "antpose/camera/board_pose.hpp"
+#include "antpose/model/box_file.hpp"
+#include "antpose/model/sampling.hpp"
+#include "registration/panel_scene.hpp"
+
+namespace antpose::registration {
+namespace {
+
+using fixture::make_scene;
+using fixture::SyntheticScene;
+
+// What the reconstruction would give: points on the panel's faces the cameras see and on the
+// mast and arms behind it (where the fixture's mast stands), 5 mm noise.
+PointCloud region_points(const SyntheticScene& s) {
+  const auto model = model::parametric_panel({});
+  const Iso3 T_antenna_board = s.T_board_antenna.inverse();
+  std::vector<Vec3> viewpoints;
+  for (const auto& v : s.views)
+    viewpoints.push_back(T_antenna_board * camera::camera_centre(v.R_camera_board, v.t_camera_board));
+  PointCloud cloud = transformed(model::visible_surface(model.mesh_antenna, viewpoints, 0.02, 5), s.T_board_antenna);
+  const Vec3 up = s.mast.up_board.normalized(), side = up.unitOrthogonal(), other = up.cross(side);
+  for (double h = -0.8; h <= 0.8; h += 0.02)
+    for (int k = 0; k < 12; ++k) {
+      const double a = 2 * M_PI * k / 12;
+      cloud.points.push_back(s.mast.axis_point_board + h * up +
+                             s.mast.radius_m * (std::cos(a) * side + std::sin(a) * other));
+    }
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> n(0.0, 0.005);
+  for (Vec3& p : cloud.points) p += Vec3(n(rng), n(rng), n(rng));
+  return cloud;
+}
+
+AntennaScene antenna_scene(const SyntheticScene& s) {
+  AntennaScene a;
+  a.views = s.views;
+  a.intrinsics = s.intrinsics;
+  for (const auto& v : s.views) a.viewpoints_board.push_back(camera::camera_centre(v.R_camera_board, v.t_camera_board));
+  a.up_board = s.mast.up_board;
+  a.points_board = region_points(s);
+  a.region_view = 3;
+  const Vec3 size = model::parametric_panel({}).size_m;
+  for (std::size_t v = 0; v < s.views.size(); ++v) {
+    Eigen::AlignedBox2d box;
+    for (const Vec3& c : model::box_corners(size))
+      box.extend(
+          *s.intrinsics.project(s.views[v].R_camera_board * (s.T_board_antenna * c) + s.views[v].t_camera_board));
+    const cv::Rect r(static_cast<int>(box.min().x()) - 12, static_cast<int>(box.min().y()) - 12,
+                     static_cast<int>(box.sizes().x()) + 24, static_cast<int>(box.sizes().y()) + 24);
+    if (v == a.region_view) a.roi = r;
+    a.areas.emplace_back(cv::Rect(r.x - r.width / 4, r.y - r.height / 4, r.width * 3 / 2, r.height * 3 / 2));
+  }
+  return a;
+}
+
+TEST(RegisterAntenna, FindsThePanelAndItsFrontWithTheMastKnown) {
+  const SyntheticScene s = make_scene();
+  AntennaScene scene = antenna_scene(s);
+  scene.mast = s.mast;
+  const auto r = register_antenna(model::parametric_panel({}), scene, {});
+  ASSERT_TRUE(r.found) << r.why_not;
+  EXPECT_LT(rad2deg(rotation_distance(r.T_board_antenna.linear(), s.T_board_antenna.linear())), 1.0);
+  EXPECT_LT((r.T_board_antenna.translation() - s.T_board_antenna.translation()).norm(), 0.02);
+  EXPECT_EQ(r.verdict, RegistrationVerdict::kUnique);
+  EXPECT_EQ(r.selection.front_back_cue, FrontBackCue::kMast);
+  EXPECT_GE(r.proposed, 2u);
+}
+
+TEST(RegisterAntenna, WithoutAMastTheMountsPointsDecideFrontAndBack) {
+  const SyntheticScene s = make_scene();
+  const auto r = register_antenna(model::parametric_panel({}), antenna_scene(s), {});
+  ASSERT_TRUE(r.found) << r.why_not;
+  EXPECT_LT(rad2deg(boresight_angle(r.T_board_antenna.linear(), s.T_board_antenna.linear())), 1.0);
+  EXPECT_EQ(r.selection.front_back_cue, FrontBackCue::kEvidence);
+}
+
+TEST(RegisterAntenna, ARectangleOnTheSkyFindsNothingAndSaysWhy) {
+  const SyntheticScene s = make_scene();
+  AntennaScene scene = antenna_scene(s);
+  scene.roi = cv::Rect(20, 20, 120, 300);  // the top left corner: sky and ground, no antenna
+  for (auto& a : scene.areas) a = cv::Rect(0, 0, 200, 400);
+  scene.points_board.points.clear();
+  const auto r = register_antenna(model::parametric_panel({}), scene, {});
+  EXPECT_FALSE(r.found);
+  EXPECT_NE(r.why_not.find("rectangle"), std::string::npos) << r.why_not;
+}
+
+}  // namespace
+}  // namespace antpose::registration
