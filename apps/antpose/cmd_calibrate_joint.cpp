@@ -70,14 +70,16 @@ store::CameraCalibrationInfo joint_intrinsics(const JointArgs& args, const std::
 CalibrationOutcome joint_calibration(const JointArgs& args, const std::optional<store::DeviceRef>& device,
                                      const std::vector<std::string>& methods, Diagnostics& diagnostics) {
   Capture capture = read_capture(args.capture, diagnostics);
-  if (device && device->profile.has_imu) {
+  const bool imu_calibrated = device && device->profile.has_imu;
+  if (imu_calibrated) {
     imu::apply(device->profile.imu, capture);
     fmt::print("IMU calibration of device '{}' applied\n", device->profile.id);
   } else {
     diagnostics.warn(args.capture, 0,
                      "no IMU calibration applied (no --device, or its profile has no imu section): the gyroscope's "
-                     "scale and misalignment errors pass into R_device_camera (a few tenths of a degree); run "
-                     "'antpose calibrate imu --device' first");
+                     "scale and misalignment errors are estimated with the photos within a phone's tolerances, and "
+                     "what remains unknown of them widens the σ of R_device_camera (a few tenths of a degree) and of "
+                     "the time offset; run 'antpose calibrate imu --device' first");
   }
   const fs::path root = args.capture;
   const auto board = camera::read_board(root / "board.yaml");
@@ -113,6 +115,7 @@ CalibrationOutcome joint_calibration(const JointArgs& args, const std::optional<
     options.time_offset_start_s = args.time_offset;
     options.estimate_time_offset = !args.fixed_time_offset;
     options.gyro_trapezoid = params.count("gyro_trapezoid") && params.at("gyro_trapezoid") != 0.0;
+    if (!imu_calibrated) options.assume_uncalibrated_gyroscope();
     if (camera_info.principal_point_sigma_px)
       options.camera_rotation_sigma_rad =
           calibration::principal_point_rotation_sigma(intrinsics, *camera_info.principal_point_sigma_px);
@@ -127,6 +130,7 @@ CalibrationOutcome joint_calibration(const JointArgs& args, const std::optional<
                          {"variance_factor", r.variance_factor},
                          {"outliers", r.outliers.size()},
                          {"photos", r.residuals.size()}};
+    outcome.residuals["gyroscope_calibrated"] = imu_calibrated;
     const Vec3 s = r.rotation_sigma_deg();
     const Vec3 e = log_so3(camera::nominal_R_device_camera().transpose() * r.R_device_camera);
     fmt::print("reference-free (orientation '{}'):\n", tracks.front().method);
@@ -135,7 +139,12 @@ CalibrationOutcome joint_calibration(const JointArgs& args, const std::optional<
                  r.R_device_camera(k, 2));
     fmt::print("  = nominal · exp(({:.3f}, {:.3f}, {:.3f})°), 1σ ({:.3f}, {:.3f}, {:.3f})° (device frame)\n",
                rad2deg(e.x()), rad2deg(e.y()), rad2deg(e.z()), s.x(), s.y(), s.z());
-    if (r.time_offset_estimated)
+    if (r.time_offset_estimated && r.gyro_correction_estimated)
+      fmt::print(
+          "  time offset {:.1f} ± {:.1f} ms (IMU instant = shot t + offset; ± {:.1f} ms without the uncalibrated "
+          "gyroscope's errors)\n",
+          1e3 * r.time_offset_s, 1e3 * r.time_offset_sigma_s, 1e3 * r.time_offset_sigma_fit_s);
+    else if (r.time_offset_estimated)
       fmt::print("  time offset {:.1f} ± {:.1f} ms (IMU instant = shot t + offset)\n", 1e3 * r.time_offset_s,
                  1e3 * r.time_offset_sigma_s);
     else
@@ -153,6 +162,11 @@ CalibrationOutcome joint_calibration(const JointArgs& args, const std::optional<
                       {"variance_factor", r.variance_factor},
                       {"warnings", r.warnings}};
     if (r.time_offset_estimated) rf["time_offset_sigma_s"] = r.time_offset_sigma_s;
+    if (r.gyro_correction_estimated) {
+      if (r.time_offset_estimated) rf["time_offset_sigma_fit_s"] = r.time_offset_sigma_fit_s;
+      rf["gyro_correction"] = io::matrix_rows_json(r.gyro_correction);
+      rf["gyro_correction_sigma"] = io::matrix_rows_json(r.gyro_correction_sigma);
+    }
     for (const auto& p : r.residuals)
       rf["photos"].push_back({{"name", p.name},
                               {"placement", p.placement},

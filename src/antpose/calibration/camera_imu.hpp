@@ -21,7 +21,10 @@
 //    correction estimated per placement (preintegration, orientation/gyro_integration.hpp):
 //    a filter's absolute attitude leans into the linear accelerations of the walk around the
 //    board, nearly constantly in the device frame, which would pass straight into X.
-//    Unknowns: X, δt, and per placement the board attitude in the gyro frame and the bias.
+//    Unknowns: X, δt, and per placement the board attitude in the gyro frame and the bias; for a
+//    gyroscope without its calibration also a correction I + G of its rates, common to all
+//    placements, with the phone's scale and cross-axis tolerances as priors, so that σ(δt) and
+//    the covariance carry what the photos leave unknown of them.
 //    Start: hand–eye rotation A X = X B on all photo pairs of a placement (Park & Martin 1994,
 //    rotation step, solved as an orthogonal Procrustes problem), board attitudes by chordal L2
 //    averaging (Hartley et al. 2013), δt by a grid search; then Ceres refines the whitened
@@ -156,6 +159,13 @@ struct ReferenceFreeOptions {
   bool gyro_trapezoid = false;
   double gyro_noise_density = 3e-4;         // rad/s/√Hz, angle random walk of the integration
   double gyro_bias_sigma_rad_s = 0.0175;    // prior σ of each placement's bias correction (1°/s)
+  /// A gyroscope without its calibration (`antpose calibrate imu`): 1σ of its scale-factor errors
+  /// and of its cross-axis (misalignment) terms, dimensionless. Both 0 (the default): the rates
+  /// are taken as calibrated. Both positive: a correction ω ← (I + G) ω common to all placements
+  /// is estimated with these priors, so the covariance and σ(δt) carry what the photos leave
+  /// unknown of it (assume_uncalibrated_gyroscope() sets a phone's budget).
+  double gyro_scale_sigma = 0.0;
+  double gyro_cross_axis_sigma = 0.0;
   double max_gyro_gap_s = 0.1;              // a longer gyroscope gap leaves the placement out
   /// 1σ of the rotation error that the intrinsics give every board pose alike (rad, about the
   /// camera's x and y axes): a principal point off by δ turns each PnP pose by about δ/f, which
@@ -167,6 +177,17 @@ struct ReferenceFreeOptions {
   double outlier_chi2 = 16.27;              // χ²₃(0.999) on the robustly normalised residual
   double min_outlier_deg = 0.1;             // and a residual angle above this (noise-free data)
   int max_iterations = 100;
+
+  /// The error budget of an uncalibrated phone gyroscope, 1σ: scale 0.5 %, each cross-axis term
+  /// 0.3 %. It is the spread of the simulator's seed-001 error model (sim::PhoneModel::random:
+  /// scale 1 + N(0, 0.005), off-diagonal misalignment N(0, 0.003)), which sim/imu_simulator.hpp
+  /// draws within the ST LSM6DS3 datasheet's tolerances (sensitivity and cross-axis ≈ 1 %, partly
+  /// trimmed by the factory calibration). A phone whose gyroscope is worse needs `calibrate imu`.
+  void assume_uncalibrated_gyroscope() {
+    gyro_scale_sigma = 0.005;
+    gyro_cross_axis_sigma = 0.003;
+  }
+  bool gyro_uncalibrated() const { return gyro_scale_sigma > 0.0 || gyro_cross_axis_sigma > 0.0; }
 };
 
 struct PhotoResidual {
@@ -197,7 +218,16 @@ struct ReferenceFreeCalibration {
   double time_offset_sigma_s = std::numeric_limits<double>::quiet_NaN();  // NaN when not estimated
   bool time_offset_estimated = false;
   double time_offset_grid_s = 0.0;        // the grid-search start
-  double variance_factor = 1.0;           // χ²/dof of the whitened residuals (scales covariance)
+  /// σ(δt) with the gyroscope correction held at its estimate: what the photos and the
+  /// gyroscope's noise alone allow (= time_offset_sigma_s for a calibrated gyroscope).
+  double time_offset_sigma_fit_s = std::numeric_limits<double>::quiet_NaN();
+  /// Uncalibrated gyroscope (ReferenceFreeOptions::gyro_scale_sigma): the estimated correction
+  /// I + G (ω_corrected = (I + G) ω_measured, before the bias) and the 1σ of G's elements.
+  bool gyro_correction_estimated = false;
+  Mat3 gyro_correction = Mat3::Identity();
+  Mat3 gyro_correction_sigma = Mat3::Zero();
+  double variance_factor = 1.0;           // χ²/dof of the whitened residuals (scales covariance;
+                                          // only from above 1 for an uncalibrated gyroscope)
   std::vector<PhotoResidual> residuals;   // one per photo used (outliers included, flagged)
   std::vector<std::size_t> outliers;      // indexes into the input photos
   std::vector<PlacementAttitude> boards;
@@ -215,12 +245,14 @@ struct ReferenceFreeCalibration {
 Vec2 principal_point_rotation_sigma(const camera::CameraIntrinsics& intrinsics, const Vec2& principal_point_sigma_px);
 
 /// Method B. `gyroscope`: the device-frame rates (rad/s) the track was estimated from, with the
-/// device's IMU calibration applied. Warnings (also in `diagnostics`) for photos outside the
-/// track (named), placements with too few photos, taken from one pose or broken by a gyroscope
-/// gap (left out), outliers, and an unobservable time
-/// offset (phone still at every shot). MeasurementError when no usable placement remains or the
-/// relative rotations are all about one axis (R_device_camera not observable). `reference`, when
-/// given, only checks the result (AngleErrorTable "reference-free").
+/// device's IMU calibration applied (or, without one, options.assume_uncalibrated_gyroscope()).
+/// Warnings (also in `diagnostics`) for photos outside the track (named), placements with too
+/// few photos, taken from one pose or broken by a gyroscope gap (left out), outliers, an
+/// unobservable time offset (phone still at every shot) and an uncalibrated gyroscope.
+/// MeasurementError when no usable placement remains, the relative rotations are all about one
+/// axis (R_device_camera not observable), or the uncalibrated gyroscope's errors alone push σ(δt)
+/// past max_time_offset_sigma_s (the message says to run `antpose calibrate imu`). `reference`,
+/// when given, only checks the result (AngleErrorTable "reference-free").
 ReferenceFreeCalibration calibrate_reference_free(const std::vector<PhotoObservation>& photos,
                                                   const orientation::SensorSeries& gyroscope,
                                                   const orientation::OrientationTrack& track,
