@@ -4,9 +4,9 @@
 // camera` (20 rendered board photos) and `calibrate joint` (the thesis's six placements, 12
 // rendered photos each, level ±0.2° and compass ±1.5°), every run stored in a device database.
 // Truth: truth/device.yaml. Seeds: ANTPOSE_JOINT_SEEDS from 101 (not the seeds the methods were
-// developed on). The everyday run takes one, to keep CI's time: MeasureAcceptance calibrates a
-// second phone (seed 401, 12 MP) through the same commands and checks its rotation too; the
-// end-to-end figures in docs/camera-imu.md take 3 (ANTPOSE_JOINT_SEEDS=3).
+// developed on). The everyday run takes one, to keep CI's time (phone 401's profile, which the
+// measurement tests use, comes from the same commands in scripts/calibrate-simulated-phone.sh);
+// the end-to-end figures in docs/camera-imu.md take 3 (ANTPOSE_JOINT_SEEDS=3).
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>

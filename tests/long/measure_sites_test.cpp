@@ -45,7 +45,7 @@ struct Site {
   bool ground = false, disturbance = false;
   int antennas = 1;
   std::string forced;       // further `simulate capture` flags
-  bool regression = false;  // a classic site where a fault was once found
+  bool regression = false;  // a classic site kept as a regression check
   int only = 0;             // the one antenna (1-based) measured, or 0 for all
   std::string warns;        // a warning the answer must give (part of its text)
 };

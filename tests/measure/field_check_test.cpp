@@ -115,7 +115,7 @@ std::vector<Vec3> with_tilt_errors(std::vector<Vec3> b, double tilt_deg, std::ui
   return b;
 }
 
-// Site 1612: from 20 m the mast's field is the same at every photo. It turns the compass by 3°
+// From 20 m, a mast's field is the same at every photo. It turns the compass by 3°
 // and steepens the dip by 1.6°; with the walk's tilt errors every photo stays within 2° of WMM's
 // dip and the photos agree, but their median dip does not agree with WMM's.
 TEST(FieldCheck, AFieldTurnedAlikeAtEveryPhotoIsSeenInTheMedianDip) {

@@ -142,7 +142,7 @@ std::vector<Vec3> at_depths(std::size_t count, double z_from, double z_to, std::
 }
 
 TEST(DepthRange, ThePanelBeforeATexturedWallNotTheWall) {
-  // 2803-2: ~30 features on a rooftop panel 4.2 m away, 295 on a wall behind it.
+  // A rooftop panel 4.2 m away with ~30 features before a textured wall with ten times as many.
   std::mt19937 rng(3);
   auto points = at_depths(30, 4.2, 4.5, rng);
   const auto wall = at_depths(300, 17.5, 18.5, rng);  // more than five times the panel's

@@ -45,6 +45,21 @@ TEST(MastSearch, APlainPoleIsFoundByItsOutlineAlone) {
   EXPECT_NEAR(mast->radius_m, s.mast.radius_m, 0.01);
 }
 
+// A panel high above the board on a short pole (a rooftop mast photographed from a street-level
+// board): the pole stands only near the panel, so its outline must be sought at the panel's height.
+TEST(MastSearch, AShortPoleFarAboveTheBoardIsFound) {
+  registration::fixture::SceneSpec spec;
+  spec.antenna_height_m = 7.0, spec.mast_base_m = 4.5;
+  const SyntheticScene s = registration::fixture::make_scene(spec);
+  const Vec3 size = model::parametric_panel({}).size_m;
+  const Inputs in = inputs(s, size);
+  const auto mast =
+      find_mast_by_outline(in.views, s.intrinsics, s.mast.up_board, s.T_board_antenna, size, in.occluders, {});
+  ASSERT_TRUE(mast);
+  const Vec3 d = mast->axis_point_board - s.mast.axis_point_board;
+  EXPECT_LT((d - d.dot(s.mast.up_board) * s.mast.up_board).norm(), 0.03);
+}
+
 TEST(MastSearch, TheStructureBehindThePanelFitsBetterThanAnyBeforeIt) {
   const SyntheticScene s = registration::fixture::make_scene();
   const Vec3 size = model::parametric_panel({}).size_m;

@@ -34,6 +34,7 @@ struct SceneSpec {
   double distance_m = 5.5, below_m = 1.3;  // the cameras from the antenna, horizontally and below it
   double antenna_height_m = 2.8;
   double mast_radius_m = 0.057, mast_behind_m = 0.35;
+  double mast_base_m = 0.0;  // world height of the pole's foot (a roof)
   double focal_px = 1050;
   std::vector<double> view_offsets_deg{-15.0, -10.0, -5.0, 0.0, 5.0, 10.0, 15.0};
   bool look_away = false;  // the cameras turned away from the antenna
@@ -66,7 +67,7 @@ inline SyntheticScene make_scene(const SceneSpec& spec = {}) {
   scene.meshes.push_back(antenna);
   sim::MeshObject pole;
   pole.name = "pole";
-  pole.mesh = sim::cylinder_mesh(Vec3(mast.x(), mast.y(), 0), Vec3(mast.x(), mast.y(), spec.antenna_height_m + 1.4),
+  pole.mesh = sim::cylinder_mesh(Vec3(mast.x(), mast.y(), spec.mast_base_m), Vec3(mast.x(), mast.y(), spec.antenna_height_m + 1.4),
                                  spec.mast_radius_m, 24);
   pole.albedo = 0.45;
   scene.meshes.push_back(pole);
@@ -89,7 +90,7 @@ inline SyntheticScene make_scene(const SceneSpec& spec = {}) {
   s.mast.up_board = T_world_board.linear().transpose() * Vec3::UnitZ();
   s.mast.axis_point_board = T_world_board.inverse() * Vec3(mast.x(), mast.y(), spec.antenna_height_m);
   s.mast.radius_m = spec.mast_radius_m;
-  s.mast.low_m = -spec.antenna_height_m, s.mast.high_m = 1.4;
+  s.mast.low_m = spec.mast_base_m - spec.antenna_height_m, s.mast.high_m = 1.4;
 
   const sim::PhotoRenderer renderer(K, 2);
   sim::SensorModel sensor;

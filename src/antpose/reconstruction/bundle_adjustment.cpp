@@ -340,12 +340,10 @@ RefinedPoses refine_camera_poses(const std::vector<PosedView>& views, const came
   report("bundle adjustment", 2, 3);
 
   // The board is the reference: true tracks move the cameras within what its corners allow, so
-  // its residual barely grows (0.04–0.05 px after the solve on 74 of 75 simulated sites). False
-  // tracks that agree with each other (a moiré on ground seen at a grazing angle, something that
-  // moved) can bend all the poses together instead: turning the cameras 0.03–0.10° from the truth
-  // (0.004–0.018° on the board alone), the board's RMS growing from 0.05 to 0.17 px, and a panel
-  // 20 m away coming out 1.4° off in downtilt. Then the poses are the
-  // board's alone.
+  // its residual barely grows (a few hundredths of a pixel). False tracks that agree with each
+  // other (a moiré on ground seen at a grazing angle, something that moved) can bend all the
+  // poses together instead: a common turn of a tenth of a degree triples the board's RMS and
+  // puts a panel 20 m away more than 1° off in downtilt. Then the poses are the board's alone.
   const double board_rms_with_scene = board_rms().first;
   const bool scene_rejected =
       board_rms_with_scene > options.max_board_rms_growth * std::max(board_only_rms, options.board_rms_floor_px);

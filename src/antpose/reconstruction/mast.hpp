@@ -76,8 +76,8 @@ std::optional<Mast> fit_mast(const PointCloud& points_board, const Vec3& up_boar
                              const MastOptions& options);
 
 /// Stage 2 alone from a cylinder found some other way (mast_search.hpp): its outline refined and
-/// confirmed in the photos as fit_mast's, between the heights `outline_low_m` and `outline_high_m`,
-/// with `occluders[i]` (image polygons, px) masked in photo i — the antenna itself, whose vertical
+/// confirmed in the photos as fit_mast's, between the heights `outline_low_m` and `outline_high_m`
+/// (along up_board from the board frame's origin, as fit_mast's), with `occluders[i]` (image polygons, px) masked in photo i — the antenna itself, whose vertical
 /// edges would pass for the mast's. nullopt when the outline does not confirm it.
 std::optional<Mast> confirm_mast(const Mast& start, const std::vector<PosedView>& views,
                                  const camera::CameraIntrinsics& intrinsics, double outline_low_m,

@@ -215,7 +215,10 @@ std::optional<Mast> find_mast_by_outline(const std::vector<PosedView>& views, co
                     [&](const Cylinder* t) { return std::hypot(t->x - c.x, t->y - c.y) < 2 * o.step_m; }))
       continue;
     tried.push_back(&c);
-    if (auto mast = confirm_mast(as_mast(*grid, c), views, K, grid->low, grid->high, occluders, o.confirmation))
+    // The grid's stretch is relative to the panel's centre; confirm_mast's heights are the board's.
+    const double centre = grid->frame.up.dot(grid->frame.centre);
+    if (auto mast = confirm_mast(as_mast(*grid, c), views, K, centre + grid->low, centre + grid->high, occluders,
+                                 o.confirmation))
       return mast;
   }
   return std::nullopt;
