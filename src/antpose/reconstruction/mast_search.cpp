@@ -179,7 +179,10 @@ std::optional<Grid> score_grid(const std::vector<PosedView>& views, const camera
     for (double y = -o.reach_m; y <= o.reach_m; y += o.step_m)
       for (const double r : o.radii_m) {
         const double d = std::hypot(x, y);
-        if (d <= o.reach_m && d > footprint + r) g.cylinders.push_back({x, y, r});
+        if (d <= o.reach_m && d > footprint + r) {
+          Cylinder& c = g.cylinders.emplace_back();
+          c.x = x, c.y = y, c.radius = r;
+        }
       }
   cv::parallel_for_(cv::Range(0, static_cast<int>(g.cylinders.size())), [&](const cv::Range& range) {
     for (int i = range.start; i < range.end; ++i) cost(g.cylinders[static_cast<std::size_t>(i)]);
