@@ -36,6 +36,22 @@ TEST(PoseSelection, AnotherYawThePhotosDoNotRuleOutIsARival) {
   EXPECT_FALSE(s.runner_up->decisive);
 }
 
+// A candidate a few degrees off that the photos do not rule out is the same answer (no rival, no
+// ambiguity), but its σ must cover it; one they rule out is left alone.
+TEST(PoseSelection, ANearPoseThePhotosDoNotRuleOutIsANearRival) {
+  const std::vector<PoseCandidate> candidates{
+      facing(40, Vec3::Zero(), {0.10, 0.11, 0.09, 0.10, 0.12, 0.10}),
+      facing(43, Vec3::Zero(), {0.11, 0.10, 0.10, 0.11, 0.11, 0.10}),   // about as good: near rival
+      facing(36, Vec3::Zero(), {0.30, 0.32, 0.29, 0.31, 0.33, 0.30})};  // clearly worse
+  const std::vector<PoseEvidence> twins(candidates.size(), side({0.0, 0.0}));
+  const Selection s = select_pose(candidates, twins, std::nullopt, {}, {});
+  EXPECT_EQ(s.best, 0u);
+  EXPECT_TRUE(s.rivals.empty());
+  EXPECT_FALSE(s.runner_up);
+  ASSERT_EQ(s.near_rivals.size(), 1u);
+  EXPECT_EQ(s.near_rivals[0], 1u);
+}
+
 TEST(PoseSelection, AMastBehindDecidesFrontAndBackWhateverTheDowntilt) {
   // The panel 0.4 m north of the mast; as registered it faces south, at its mast: turned round
   // it faces north, away from it. An uptilt as registered changes nothing.
@@ -61,6 +77,21 @@ TEST(PoseSelection, WithoutACueFrontAndBackStayOpen) {
   EXPECT_FALSE(decided.front_back_open);
   EXPECT_FALSE(decided.turned);
   EXPECT_EQ(decided.front_back_cue, FrontBackCue::kEvidence);
+}
+
+// A box turned upside down about its boresight is the same box: the pose keeps its boresight and
+// its long axis turns upward; an upright pose is left alone.
+TEST(PoseSelection, UprightTurnsAnUpsideDownPoseAboutItsBoresight) {
+  const Mat3 R_board_level = exp_so3(Vec3(0.2, -0.1, 0.4));  // the board is not level
+  const Vec3 up_board = R_board_level * Vec3::UnitZ();
+  const Mat3 R = R_board_level * rot_z(-deg2rad(40)) * rot_x(-deg2rad(6)) * rot_y(deg2rad(2));
+  EXPECT_TRUE(upright(R, up_board).isApprox(R));
+  const Mat3 upside_down = R * rot_y(M_PI);
+  const Mat3 fixed = upright(upside_down, up_board);
+  EXPECT_LT(rotation_distance(fixed, R), 1e-9);
+  const Iso3 T = upright(isometry(upside_down, Vec3(1, 2, 3)), up_board);
+  EXPECT_LT(rotation_distance(T.linear(), R), 1e-9);
+  EXPECT_TRUE(T.translation().isApprox(Vec3(1, 2, 3)));
 }
 
 }  // namespace

@@ -119,6 +119,7 @@ void apply_registration(AntennaMeasurement& m, const model::AntennaModel& model,
   m.p_board_antenna = r.T_board_antenna.translation();
   m.cov_board = r.rotation_covariance_board + c.cov_poses_board;
   for (const auto& rival : r.rivals) m.rivals_board.push_back(rival.linear());
+  for (const auto& rival : r.near_rivals) m.rivals_board.push_back(rival.linear());
   m.verdict = r.verdict;
   m.runner_up = r.selection.runner_up;
   m.front_back = r.selection.front_back;

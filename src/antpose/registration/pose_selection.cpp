@@ -45,6 +45,17 @@ Iso3 turned_round(const Iso3& T_board_antenna) {
   return T;
 }
 
+Mat3 upright(const Mat3& R_board_antenna, const Vec3& up_board) {
+  if (R_board_antenna.col(2).dot(up_board) >= 0.0) return R_board_antenna;
+  return R_board_antenna * Vec3(-1.0, 1.0, -1.0).asDiagonal();
+}
+
+Iso3 upright(const Iso3& T_board_antenna, const Vec3& up_board) {
+  Iso3 T = T_board_antenna;
+  T.linear() = upright(T_board_antenna.linear(), up_board);
+  return T;
+}
+
 double boresight_angle(const Mat3& a, const Mat3& b) { return angle_between(a.col(1), b.col(1)); }
 
 OptionProblems SelectionOptions::Check() const {
@@ -71,9 +82,13 @@ Selection select_pose(const std::vector<PoseCandidate>& candidates, const std::v
   for (std::size_t k = 1; k < order.size(); ++k) {
     const auto& c = candidates[order[k]];
     const double angle = boresight_angle(c.T_board_antenna.linear(), R_best);
-    // Another answer: a boresight elsewhere, not just the winner turned round.
-    if (angle <= rival_min || angle >= M_PI - rival_min) continue;
+    if (angle >= M_PI - rival_min) continue;  // the winner turned round: front and back
     const Comparison versus = compare_shape(candidates[s.best].evidence, c.evidence, evidence);
+    // The same answer a few degrees off, or another: a boresight elsewhere.
+    if (angle <= rival_min) {
+      if (!versus.decisive) s.near_rivals.push_back(order[k]);
+      continue;
+    }
     if (!s.runner_up) s.runner_up = versus;
     if (!versus.decisive) s.rivals.push_back(order[k]);
   }

@@ -3,7 +3,9 @@
 // Shape first: the candidate with the lowest score wins; every other candidate whose boresight is
 // more than `rival_min_deg` from the winner's (its turned-round twin excepted: that is front and
 // back) and that the winner does not beat decisively is a rival — the photos and points do not
-// tell the two apart, and the answer must say so (a σ that covers both, or a refusal).
+// tell the two apart, and the answer must say so (a σ that covers both, or a refusal). A nearer
+// candidate the winner does not beat decisively (another local minimum a few degrees off) is the
+// same answer, but the σ must cover it too: a near rival.
 // Then front and back, which the box's outline cannot tell: the winner against its twin turned
 // by 180° about its long axis. A known mast decides first where it stands clearly behind one of
 // them (a panel's back plate faces its mount); otherwise the side units (the vertical structure
@@ -46,6 +48,7 @@ struct Selection {
   std::size_t best = 0;                 // index into the candidates; its twin turned round is not among them
   bool turned = false;                  // the best's twin won front and back: use it turned round
   std::vector<std::size_t> rivals;      // shape rivals, best first
+  std::vector<std::size_t> near_rivals; // within rival_min_deg, not beaten decisively, best first
   std::optional<Comparison> runner_up;  // the best against the best distinct other candidate
   FrontBackCue front_back_cue = FrontBackCue::kNone;
   Comparison front_back;         // the chosen side against the other (side units)
@@ -62,6 +65,13 @@ Selection select_pose(const std::vector<PoseCandidate>& candidates, const std::v
 /// box's outline the same.
 Mat3 turned_round(const Mat3& R_board_antenna);
 Iso3 turned_round(const Iso3& T_board_antenna);
+
+/// R_board_antenna with its long axis z_a upward (against `up_board`): where it points down, turned
+/// by 180° about its boresight y_a. A box is symmetric under that half turn, so its outline and
+/// points cannot tell a panel's top end cap from its bottom one; panels hang top end up (z_a runs
+/// towards the top end cap: ../shared/notes/antenna-model.md).
+Mat3 upright(const Mat3& R_board_antenna, const Vec3& up_board);
+Iso3 upright(const Iso3& T_board_antenna, const Vec3& up_board);
 
 /// The angle between two poses' boresights (y_a), rad.
 double boresight_angle(const Mat3& R_board_a, const Mat3& R_board_b);

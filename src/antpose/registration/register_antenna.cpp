@@ -200,14 +200,21 @@ AntennaRegistration select(const AntennaScene& s, std::vector<Refined> kept, con
   const auto& sel = out.selection;
   Refined& best = kept[sel.best];
   out.T_board_antenna = sel.turned ? turned_round(best.candidate.T_board_antenna) : best.candidate.T_board_antenna;
+  // A parametric panel is a box with brackets alike at both ends: its top is the end up.
+  const bool symmetric_ends = best.model->panel != nullptr;
+  if (symmetric_ends) out.T_board_antenna = upright(out.T_board_antenna, s.up_board);
   out.rotation_covariance_board = best.outline.covariance.topLeftCorner<3, 3>();
   if (best.radius) out.rotation_covariance_board += best.radius->spread_board;
   out.dilation_yaw_sigma_rad = best.outline.dilation_yaw_sigma_rad;
   out.outline_score = best.outline.score, out.outline_rms_px = best.outline.rms_px;
   out.outline_views = best.outline.views_used;
   out.edge_radius = std::move(best.radius);
-  for (const auto i : sel.rivals)
-    out.rivals.push_back(rival_facing(candidates[i].T_board_antenna, out.T_board_antenna));
+  const auto facing_as_result = [&](std::size_t i) {
+    const Iso3 rival = rival_facing(candidates[i].T_board_antenna, out.T_board_antenna);
+    return symmetric_ends ? upright(rival, s.up_board) : rival;
+  };
+  for (const auto i : sel.rivals) out.rivals.push_back(facing_as_result(i));
+  for (const auto i : sel.near_rivals) out.near_rivals.push_back(facing_as_result(i));
   if (sel.front_back_open) out.rivals.push_back(turned_round(out.T_board_antenna));
   out.verdict = !sel.rivals.empty()   ? RegistrationVerdict::kAmbiguousShape
                 : sel.front_back_open ? RegistrationVerdict::kFrontBackOpen

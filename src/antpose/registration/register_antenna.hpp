@@ -94,6 +94,7 @@ struct AntennaRegistration {
   std::size_t outline_views = 0;
   RegistrationVerdict verdict = RegistrationVerdict::kUnique;
   std::vector<Iso3> rivals;  // other poses the evidence does not rule out (front and back as decided)
+  std::vector<Iso3> near_rivals;  // poses within a few degrees it does not rule out: the σ covers them
   Selection selection;
   std::vector<PoseCandidate> candidates;  // refined, distinct, with their evidence
   std::size_t proposed = 0;               // candidates the strategies proposed
