@@ -59,6 +59,25 @@ TEST(OutlineSearch, FindsThePanelFromAFarStartWithoutTexture) {
   for (std::size_t k = 1; k < result.candidates.size(); ++k) EXPECT_GE(result.candidates[k].cost, best.cost);
 }
 
+// With no start but the user's rectangle: drawn tight or with wide margins (the box filling from
+// all of it down to three fifths of its larger side), the box is found at the depth that fills it.
+TEST(OutlineSearch, FindsThePanelFromTheRectangleHoweverItIsDrawn) {
+  const SyntheticScene s = make_scene();
+  const Vec3 size = model::parametric_panel({}).size_m;
+  for (const double margin : {0.0, 0.12, 0.3}) {
+    SCOPED_TRACE(margin);
+    OutlineSearchInput in = input_for(s, size, Vec3::Zero());
+    in.starts_board.clear();
+    in.roi = rectangle_around(s, in.region_view, size, margin);
+    const auto result = search_box_outline(in, s.intrinsics, {});
+    ASSERT_FALSE(result.candidates.empty());
+    const auto& best = result.candidates.front();
+    EXPECT_LT(box_error_deg(best.T_board_antenna.linear(), s.T_board_antenna.linear()), 6.0);
+    EXPECT_LT((best.T_board_antenna.translation() - s.T_board_antenna.translation()).norm(), 0.06);
+    EXPECT_LT(best.cost, 0.3);
+  }
+}
+
 TEST(OutlineSearch, ChecksItsOptionsAndInputs) {
   OutlineSearchOptions o;
   o.yaw_step_deg = 0;

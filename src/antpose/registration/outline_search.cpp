@@ -55,18 +55,19 @@ struct Probe {
 };
 
 // The box's centre on the rectangle's centre ray at the depth where the box at R_board_antenna
-// fills the rectangle as a user draws it (its projected larger side a tenth shorter than the
-// rectangle's): the projection's size goes as 1/depth, refined twice for perspective.
-std::optional<Vec3> fitted_start(const OutlineSearchInput& in, const camera::CameraIntrinsics& K, const Mat3& R) {
+// spans `fill` of the rectangle's larger side: the projection's size goes as 1/depth, refined
+// twice for perspective. Also the projected larger side there (px).
+std::optional<std::pair<Vec3, double>> filling_start(const OutlineSearchInput& in, const camera::CameraIntrinsics& K,
+                                                     const Mat3& R, double fill) {
   const auto& view = (*in.views)[in.region_view];
   const cv::Rect& roi = *in.roi;
   const Vec3 ray = K.ray(Vec2(roi.x + 0.5 * roi.width - 0.5, roi.y + 0.5 * roi.height - 0.5));
-  const double target = std::max(roi.width, roi.height) / 1.1;
+  const double target = fill * std::max(roi.width, roi.height);
   const Mat3 R_board_camera = view.R_camera_board.transpose();
   const auto centre_at = [&](double depth) {
     return Vec3(R_board_camera * (ray / ray.z() * depth - view.t_camera_board));
   };
-  double depth = K.fx * in.box_size_m.z() / target;
+  double depth = K.fx * in.box_size_m.z() / target, size = target;
   for (int k = 0; k < 3; ++k) {
     Eigen::AlignedBox2d box;
     for (const Vec3& c : corners(in.box_size_m, R, centre_at(depth))) {
@@ -74,11 +75,38 @@ std::optional<Vec3> fitted_start(const OutlineSearchInput& in, const camera::Cam
       if (!uv) return std::nullopt;
       box.extend(*uv);
     }
-    const double size = box.sizes().maxCoeff();
+    size = box.sizes().maxCoeff();
     if (!(size > 0)) return std::nullopt;
     depth *= size / target;
   }
-  return centre_at(depth);
+  return std::pair{centre_at(depth), size};
+}
+
+// How much of the rectangle the antenna fills is the user's habit: from all of its larger side
+// down to the least that still covers `min_roi_fill` of it. The box's centre is swept along the
+// rectangle's centre ray over those depths, each step moving the box's ends by about the
+// chamfer's truncation (so that no depth falls between two samples' basins), and the best start
+// kept: a single guessed fill leaves a long box's ends outside the truncation, with no gradient.
+std::optional<Vec3> swept_start(const BoxOutlineCost& cost, const OutlineSearchInput& in,
+                                const camera::CameraIntrinsics& K, const Mat3& R, const OutlineSearchOptions& o,
+                                std::size_t& evaluations) {
+  const auto full = filling_start(in, K, R, 1.0);
+  if (!full) return std::nullopt;
+  const double length_map_px = full->second * cost.map_scale();
+  const double least = std::sqrt(in.min_roi_fill);
+  const double ratio = std::max(1.0 + 2.0 * o.truncation_px / std::max(1.0, length_map_px),
+                                std::pow(1.0 / least, 1.0 / static_cast<double>(o.max_depth_starts)));
+  std::optional<Vec3> best;
+  double best_cost = 2.0;
+  for (double fill = 1.0; fill >= least; fill /= ratio) {
+    const auto start = filling_start(in, K, R, fill);
+    if (!start) continue;
+    Iso3 T = Iso3::Identity();
+    T.linear() = R, T.translation() = start->first;
+    ++evaluations;
+    if (const double c = cost(T).first; c < best_cost) best_cost = c, best = start->first;
+  }
+  return best;
 }
 
 // The compass search for the box's centre at one orientation: steps along the region photo's
@@ -162,6 +190,7 @@ OptionProblems OutlineSearchOptions::Check() const {
   p.require(min_views >= 1, "min_views", "at least 1");
   p.require(separation_deg >= 0, "separation_deg", "≥ 0");
   p.require(max_candidates >= 1, "max_candidates", "at least 1");
+  p.require(max_depth_starts >= 1, "max_depth_starts", "at least 1");
   p.require(min_step_map_px > 0 && min_turn_deg > 0, "min_step_map_px, min_turn_deg", "positive");
   p.nest("edges", edges.Check());
   return p;
@@ -174,13 +203,13 @@ BoxOutlineCost::BoxOutlineCost(const OutlineSearchInput& input, const camera::Ca
   if (!(input.box_size_m.array() > 0).all()) throw std::invalid_argument("search_box_outline: a non-positive box");
   if (input.areas.size() != input.views->size())
     throw std::invalid_argument("search_box_outline: one area per view expected");
-  const double scale = std::min(1.0, options.map_width_px / std::max(1.0, input.expected_width_px));
+  scale_ = std::min(1.0, options.map_width_px / std::max(1.0, input.expected_width_px));
   maps_.resize(input.views->size(), EdgeDistance(cv::Mat(), {}, 1.0, {}, options.edges));
   cv::parallel_for_(cv::Range(0, static_cast<int>(maps_.size())), [&](const cv::Range& r) {
     for (int i = r.start; i < r.end; ++i) {
       const auto& v = (*input.views)[static_cast<std::size_t>(i)];
       if (const auto& area = input.areas[static_cast<std::size_t>(i)])
-        maps_[static_cast<std::size_t>(i)] = EdgeDistance(v.image, *area, scale, v.occluders, options.edges);
+        maps_[static_cast<std::size_t>(i)] = EdgeDistance(v.image, *area, scale_, v.occluders, options.edges);
     }
   });
 }
@@ -260,12 +289,12 @@ OutlineSearchResult search_box_outline(const OutlineSearchInput& input, const ca
   const auto& region = (*input.views)[input.region_view];
   const Mat3 R_board_camera = region.R_camera_board.transpose();
   const auto orientations = hanging_orientations(input.up_board, options);
-  // Every orientation from every start: the given ones, and the one fitted to the rectangle.
-  std::vector<std::pair<std::size_t, Vec3>> tasks;
+  // Every orientation from every start: the given ones, and the one swept along the rectangle's
+  // centre ray (nullopt here).
+  std::vector<std::pair<std::size_t, std::optional<Vec3>>> tasks;
   for (std::size_t o = 0; o < orientations.size(); ++o) {
     for (const Vec3& start : input.starts_board) tasks.emplace_back(o, start);
-    if (input.roi)
-      if (const auto start = fitted_start(input, intrinsics, orientations[o])) tasks.emplace_back(o, *start);
+    if (input.roi) tasks.emplace_back(o, std::nullopt);
   }
   // Steps as image motion in the region photo's maps: a few map pixels laterally to start; along
   // the line of sight the same motion of the box's edges takes depth/width times more.
@@ -274,14 +303,17 @@ OutlineSearchResult search_box_outline(const OutlineSearchInput& input, const ca
   std::vector<std::size_t> evaluations(tasks.size(), 0);
   cv::parallel_for_(cv::Range(0, static_cast<int>(tasks.size())), [&](const cv::Range& r) {
     for (int i = r.start; i < r.end; ++i) {
-      const auto& [o, start] = tasks[static_cast<std::size_t>(i)];
-      const double depth = std::max(0.5, (region.R_camera_board * start + region.t_camera_board).z());
+      const auto k = static_cast<std::size_t>(i);
+      const Mat3& R = orientations[tasks[k].first];
+      const auto start =
+          tasks[k].second ? tasks[k].second : swept_start(cost, input, intrinsics, R, options, evaluations[k]);
+      if (!start) continue;
+      const double depth = std::max(0.5, (region.R_camera_board * *start + region.t_camera_board).z());
       const double depth_per_width = depth / input.box_size_m.x();
       const Vec3 step0(4 * map_px_m, 4 * map_px_m, 0.1 * depth);
       const Vec3 step_min(options.min_step_map_px * map_px_m, options.min_step_map_px * map_px_m,
                           std::min(0.05 * depth, options.min_step_map_px * map_px_m * depth_per_width));
-      best[static_cast<std::size_t>(i)] = place_box(cost, orientations[o], start, R_board_camera, step0, step_min,
-                                                    evaluations[static_cast<std::size_t>(i)]);
+      best[k] = place_box(cost, R, *start, R_board_camera, step0, step_min, evaluations[k]);
     }
   });
   OutlineSearchResult out;

@@ -12,11 +12,12 @@
 // long axis tilted from the vertical by a downtilt in `tilt_deg` and a roll in `roll_deg`, turned
 // about the vertical by every `yaw_step_deg` over 180° (a box turned by 180° about its long axis
 // has the same outline: front and back are decided later, by what differs). For each
-// orientation the box's centre is searched from each start position by a compass search
-// (Kolda, Lewis & Torczon, SIAM Review 45(3), 2003) along the region photo's image axes and its
-// line of sight, among the poses that fit the user's rectangle (their box fills it and is centred
-// in it: it was drawn around this antenna, not its neighbour). The best poses, each at least `separation_deg` in orientation or a box width in
-// position from every better one, are then polished by the same compass search over all six
+// orientation the box's centre is searched from each start position (and from the best depth at
+// which the box fills the rectangle as a user may draw it) by a compass search (Kolda, Lewis &
+// Torczon, SIAM Review 45(3), 2003) along the region photo's image axes and its line of sight,
+// among the poses that fit the user's rectangle (their box fills it and is centred in it: it was
+// drawn around this antenna, not its neighbour). The best poses, each at least `separation_deg`
+// in orientation or a box width in position from every better one, are then polished by the same compass search over all six
 // degrees of freedom (turns about the box's own axes), so that the refinement by the outline's
 // edges (silhouette.hpp) starts within its narrow basin.
 #pragma once
@@ -45,8 +46,9 @@ struct OutlineSearchOptions {
   std::size_t min_views = 2;
   double separation_deg = 8;  // between the orientations of two results (modulo the 180° turn)
   std::size_t max_candidates = 8;
-  double min_step_map_px = 0.5;  // the compass search's last step, as image motion in the maps
-  double min_turn_deg = 0.25;    // the last turn of the candidates' polish over all six degrees
+  std::size_t max_depth_starts = 24;  // depths tried along the rectangle's centre ray, per orientation
+  double min_step_map_px = 0.5;       // the compass search's last step, as image motion in the maps
+  double min_turn_deg = 0.25;         // the last turn of the candidates' polish over all six degrees
   EdgeDistanceOptions edges;
   OptionProblems Check() const;
 };
@@ -90,6 +92,7 @@ class BoxOutlineCost {
   /// The cost (0..1) and the number of photos that counted; 1 and 0 where fewer than min_views did.
   std::pair<double, std::size_t> operator()(const Iso3& T_board_antenna) const;
   const std::vector<EdgeDistance>& maps() const { return maps_; }
+  double map_scale() const { return scale_; }  // map px per photo px
 
  private:
   double view_cost(std::size_t v, const std::array<Vec3, 8>& corners_board, bool& counted) const;
@@ -98,6 +101,7 @@ class BoxOutlineCost {
   const camera::CameraIntrinsics& intrinsics_;
   const OutlineSearchOptions& options_;
   std::vector<EdgeDistance> maps_;
+  double scale_ = 1.0;
 };
 
 }  // namespace antpose::registration
