@@ -77,7 +77,9 @@ TEST(Silhouette, RecoversYawFromAPerturbedStart) {
   EXPECT_LT(r.rms_px, 1.0);
   for (int i = 0; i < 3; ++i) {
     EXPECT_GT(sigma_deg[i], 0.002) << "axis " << i;  // not absurdly confident
-    EXPECT_LT(sigma_deg[i], 0.5) << "axis " << i;
+    // Not uselessly wide: the yaw's σ holds the model's shape tolerance along the long edges,
+    // which a narrow panel's width turns into tenths of a degree.
+    EXPECT_LT(sigma_deg[i], 0.6) << "axis " << i;
     EXPECT_LT(std::abs(after[i]), 3 * sigma_deg[i] + 0.01) << "axis " << i;
   }
 }

@@ -38,7 +38,10 @@
 // residual variance, κ = correlation_length_px / sample_spacing_px because neighbouring samples
 // share the blur and JPEG blocks. The sum models errors common to all samples of a mesh edge,
 // which do not average out along it nor over the views: b_g = Σ_{i∈g} w_i J_iᵀ s_i over all views,
-// once with s_i = f · shape_tolerance_m / depth (the model's shape error) and once with
+// once with s_i = f · shape_tolerance_m / depth (the model's shape error: a real radome's
+// extrusion, rounding and end caps depart from the model by millimetres along a whole edge, and
+// where the views leave a turn weakly observed, such as a panel seen from below turning about the
+// horizontal across the line of sight, that error reads as tenths of a degree) and once with
 // s_i = edge_bias_px (edge localisation biased by the shading of rounded edges near the outline and
 // by the background, both similar from view to view under one sun). One more such b, over every
 // sample of every edge with s_i = outline_dilation_px, is the whole outline found wider (or
@@ -102,7 +105,7 @@ struct SilhouetteOptions {
   double roi_margin_px = 40;          // around the projected model (plus 10 % of its size)
   double mask_guard_px = 3;           // occluders and background edges widened by this, per level
   double correlation_length_px = 12;  // covariance inflation (see the file comment)
-  double shape_tolerance_m = 0.001;   // model vs real panel, per mesh edge (covariance)
+  double shape_tolerance_m = 0.002;   // model vs real panel, per mesh edge (covariance)
   double edge_bias_px = 0.1;          // edge-localisation bias per mesh edge, all views (covariance)
   double outline_dilation_px = 0.10;  // the same, common to the whole outline in all views (covariance)
   // The model's box (width, depth, height along x_a, y_a, z_a, centred at the antenna frame's
