@@ -17,9 +17,9 @@
 // Torczon, SIAM Review 45(3), 2003) along the region photo's image axes and its line of sight,
 // among the poses that fit the user's rectangle (their box fills it and is centred in it: it was
 // drawn around this antenna, not its neighbour). The best poses, each at least `separation_deg`
-// in orientation or a box width in position from every better one, are then polished by the same compass search over all six
-// degrees of freedom (turns about the box's own axes), so that the refinement by the outline's
-// edges (silhouette.hpp) starts within its narrow basin.
+// in orientation or a box width in position from every better one, are then polished by the same
+// compass search over all six degrees of freedom (turns about the box's own axes), so that the
+// refinement by the outline's edges (silhouette.hpp) starts within its narrow basin.
 #pragma once
 
 #include <array>

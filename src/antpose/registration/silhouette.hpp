@@ -20,10 +20,11 @@
 // score with attachments only.
 // Gauss–Newton with Tukey's biweight (scale from the MAD) solves for the pose, each step's
 // rotation held within a trust region (max_step_rotation_rad: the yaw about the long axis is
-// weakly fixed and a free step can jump basins); silhouettes are re-extracted every iteration. A Gaussian pyramid (cv::pyrDown) runs coarse-to-fine: wide
-// searches on blurred images first (inner shading gone), ±4 px last. Optionally a monotone
-// descent at full resolution: a step that raises the score is halved, as a line search would
-// (Nocedal & Wright, Numerical Optimization, ch. 3), and none lowering it ends the descent.
+// weakly fixed and a free step can jump basins); silhouettes are re-extracted every iteration.
+// A Gaussian pyramid (cv::pyrDown) runs coarse-to-fine: wide searches on blurred images first
+// (inner shading gone), ±4 px last. Optionally a monotone descent at full resolution: a step
+// that raises the score is halved, as a line search would (Nocedal & Wright, Numerical
+// Optimization, ch. 3), and none lowering it ends the descent.
 // Scene edges not in the model (clamp arms, mast, board) are down-weighted by the robust loss;
 // known objects (the board, a mast fitted to the scene) are masked out of the search instead.
 // Edges are searched in linear intensity (the photo's gamma undone): in encoded values a blurred
