@@ -11,6 +11,7 @@
 #include <Eigen/LU>
 #include <Eigen/Eigenvalues>
 #include <Eigen/SVD>
+#include <ceres/normal_prior.h>
 #include <ceres/ceres.h>
 #include <ceres/rotation.h>
 #include <fmt/format.h>
@@ -34,12 +35,12 @@ namespace {
 /// One placement's photos and the gyroscope integrated across them.
 struct Segment {
   std::string placement;
-  std::vector<std::size_t> members;                // positions in FreeProblem::index
+  std::vector<std::size_t> members;                  // positions in FreeProblem::index
   std::optional<orientation::GyroIntegration> gyro;  // device(t) → device(t0), current bias
-  Vec3 bias = Vec3::Zero();                        // accumulated bias correction (rad/s)
-  std::array<double, 3> db{0, 0, 0};               // its increment in the current linearisation
-  Mat3 B0 = Mat3::Identity();                      // R_gyro_board (gyro frame = device at t0)
-  std::array<double, 3> b{0, 0, 0};                // board perturbation, gyro frame
+  Vec3 bias = Vec3::Zero();                          // accumulated bias correction (rad/s)
+  std::array<double, 3> db{0, 0, 0};                 // its increment in the current linearisation
+  Mat3 B0 = Mat3::Identity();                        // R_gyro_board (gyro frame = device at t0)
+  std::array<double, 3> b{0, 0, 0};                  // board perturbation, gyro frame
   Mat3 board() const { return exp_so3(Vec3(b[0], b[1], b[2])) * B0; }
 };
 
@@ -83,28 +84,11 @@ struct PreintegratedBoardResidual {
   }
 };
 
-/// Prior on a segment's total bias correction: (bias + δb) / σ_b.
-struct BiasPrior {
-  Vec3 bias;
-  double inv_sigma;
-  template <typename T>
-  bool operator()(const T* db, T* residual) const {
-    for (int r = 0; r < 3; ++r) residual[r] = (T(bias[r]) + db[r]) * T(inv_sigma);
-    return true;
-  }
-};
-
-/// Prior on the total gyroscope correction of an uncalibrated gyroscope, element by element:
-/// (G + δG)_rc / σ_rc, σ the scale-factor budget on the diagonal and the cross-axis budget off it.
-struct GyroCorrectionPrior {
-  Mat3 G;
-  Mat3 inv_sigma;
-  template <typename T>
-  bool operator()(const T* dg, T* residual) const {
-    for (int k = 0; k < 9; ++k) residual[k] = (T(G(k / 3, k % 3)) + dg[k]) * T(inv_sigma(k / 3, k % 3));
-    return true;
-  }
-};
+/// A prior on a total correction, value + δ, element by element: (value + δ) / σ, as ceres's
+/// NormalPrior A (δ − b) with A = diag(1/σ) and b = −value.
+ceres::CostFunction* total_correction_prior(const ceres::Vector& value, const ceres::Vector& inv_sigma) {
+  return new ceres::NormalPrior(ceres::Matrix(inv_sigma.asDiagonal()), -value);
+}
 
 /// The samples of `series` that an integration over [t0, t1] reads (two either side), their rates
 /// multiplied by M.
@@ -195,8 +179,7 @@ struct FreeProblem {
     const auto& g = *segments[group[k]].gyro;
     const Mat3 R_gc = g.at(ph.t_shot + dt).R * X0;
     const double walk = o.gyro_noise_density * o.gyro_noise_density * std::max(0.0, ph.t_shot + dt - g.t0());
-    return R_gc * cov_c * R_gc.transpose() +
-           Mat3::Identity() * (walk + std::pow(deg2rad(o.sigma_floor_deg), 2));
+    return R_gc * cov_c * R_gc.transpose() + Mat3::Identity() * (walk + std::pow(deg2rad(o.sigma_floor_deg), 2));
   }
 
   /// Residual rotation vector of photo k at the current estimate (gyro frame, exact time).
@@ -292,15 +275,16 @@ struct FreeProblem {
       }
       for (auto& seg : segments)
         if (problem.HasParameterBlock(seg.db.data()))
-          problem.AddResidualBlock(
-              new ceres::AutoDiffCostFunction<BiasPrior, 3, 3>(new BiasPrior{seg.bias, inv_sigma_b}), nullptr,
-              seg.db.data());
+          problem.AddResidualBlock(total_correction_prior(seg.bias, Vec3::Constant(inv_sigma_b)), nullptr,
+                                   seg.db.data());
       if (estimate_gyro()) {
         Mat3 inv_sigma = Mat3::Constant(1.0 / options->gyro_cross_axis_sigma);
         inv_sigma.diagonal().setConstant(1.0 / options->gyro_scale_sigma);
+        // δG is stored row-major (dg[3r + c]), as is the transposed column-major view below.
+        const Mat3 G_t = G.transpose(), inv_sigma_t = inv_sigma.transpose();
         problem.AddResidualBlock(
-            new ceres::AutoDiffCostFunction<GyroCorrectionPrior, 9, 9>(new GyroCorrectionPrior{G, inv_sigma}), nullptr,
-            dg.data());
+            total_correction_prior(ceres::Vector::Map(G_t.data(), 9), ceres::Vector::Map(inv_sigma_t.data(), 9)),
+            nullptr, dg.data());
       } else {
         problem.SetParameterBlockConstant(dg.data());
       }
@@ -384,7 +368,8 @@ ReferenceFreeCalibration calibrate_reference_free(const std::vector<PhotoObserva
                                                   const BoardReference* reference) {
   ReferenceFreeCalibration out;
   auto& warnings = out.warnings;
-  if (gyroscope.size() < 2) throw MeasurementError("camera–IMU calibration: the gyroscope stream has fewer than 2 samples");
+  if (gyroscope.size() < 2)
+    throw MeasurementError("camera–IMU calibration: the gyroscope stream has fewer than 2 samples");
   if (!(options.gyro_bias_sigma_rad_s > 0.0))
     throw std::invalid_argument("calibrate_reference_free: gyro_bias_sigma_rad_s must be positive");
   if (!(options.gyro_scale_sigma >= 0.0 && options.gyro_cross_axis_sigma >= 0.0) ||
@@ -445,9 +430,10 @@ ReferenceFreeCalibration calibrate_reference_free(const std::vector<PhotoObserva
     fp.segments.push_back(std::move(seg));
   }
   if (fp.segments.empty())
-    throw MeasurementError(fmt::format("camera–IMU calibration: no usable placement ({} photos given, {} inside the "
-                                       "orientation track; see the warnings)",
-                                       photos.size(), usable.size()));
+    throw MeasurementError(
+        fmt::format("camera–IMU calibration: no usable placement ({} photos given, {} inside the "
+                    "orientation track; see the warnings)",
+                    photos.size(), usable.size()));
 
   // Observability of the rotation: the relative camera rotations must not all share one axis.
   {
@@ -456,7 +442,8 @@ ReferenceFreeCalibration calibrate_reference_free(const std::vector<PhotoObserva
     for (std::size_t i = 0; i < fp.index.size(); ++i)
       for (std::size_t j = i + 1; j < fp.index.size(); ++j)
         if (fp.group[i] == fp.group[j]) {
-          const Vec3 beta = log_so3(photos[fp.index[i]].R_camera_board * photos[fp.index[j]].R_camera_board.transpose());
+          const Vec3 beta =
+              log_so3(photos[fp.index[i]].R_camera_board * photos[fp.index[j]].R_camera_board.transpose());
           S += beta * beta.transpose();
           ++pairs;
         }
@@ -503,8 +490,8 @@ ReferenceFreeCalibration calibrate_reference_free(const std::vector<PhotoObserva
   if (free_dt && (dt0 <= options.time_offset_min_s + 0.5 * options.time_offset_step_s ||
                   dt0 >= options.time_offset_max_s - 0.5 * options.time_offset_step_s))
     warn(diagnostics, warnings,
-         fmt::format("time offset search ended at the edge of [{}, {}] s ({} s): widen the bracket", options.time_offset_min_s,
-                     options.time_offset_max_s, dt0));
+         fmt::format("time offset search ended at the edge of [{}, {}] s ({} s): widen the bracket",
+                     options.time_offset_min_s, options.time_offset_max_s, dt0));
   out.time_offset_grid_s = dt0;
   fp.dt = dt0;
   fp.closed_form(dt0, fp.X0, boards);
@@ -523,13 +510,16 @@ ReferenceFreeCalibration calibrate_reference_free(const std::vector<PhotoObserva
   const double scale = std::max(median(chi2) / 2.366, 1e-12);  // median of χ²₃ is 2.366
   std::size_t outliers = 0;
   for (std::size_t k = 0; k < n; ++k)
-    if (chi2[k] / scale > options.outlier_chi2 && rad2deg(angle[k]) > options.min_outlier_deg) use[k] = false, ++outliers;
+    if (chi2[k] / scale > options.outlier_chi2 && rad2deg(angle[k]) > options.min_outlier_deg)
+      use[k] = false, ++outliers;
   if (outliers > 0)
     warn(diagnostics, warnings,
-         fmt::format("{} of {} photos are outliers (residual beyond χ²₃ = {} of the robust scale); refitted without them",
-                     outliers, n, options.outlier_chi2));
+         fmt::format(
+             "{} of {} photos are outliers (residual beyond χ²₃ = {} of the robust scale); refitted without them",
+             outliers, n, options.outlier_chi2));
   if (outliers * 3 > n)
-    warn(diagnostics, warnings, "more than a third of the photos are outliers: check the board detection and the track");
+    warn(diagnostics, warnings,
+         "more than a third of the photos are outliers: check the board detection and the track");
 
   // Pass 2: least squares on the inliers, covariance from Ceres scaled by the residual variance.
   // Parameters: x, and per segment a board attitude and a bias (the bias has its prior's 3 rows).
@@ -545,7 +535,8 @@ ReferenceFreeCalibration calibrate_reference_free(const std::vector<PhotoObserva
     out.variance_factor = dof > 0 ? 2.0 * sol.cost / dof : 1.0;
     const double scale = fp.estimate_gyro() ? std::max(1.0, out.variance_factor) : out.variance_factor;
     if (sol.cov_x) out.covariance = *sol.cov_x * scale;
-    const Vec3 bias_var(std::pow(options.camera_rotation_sigma_rad.x(), 2), std::pow(options.camera_rotation_sigma_rad.y(), 2), 0.0);
+    const Vec3 bias_var(std::pow(options.camera_rotation_sigma_rad.x(), 2),
+                        std::pow(options.camera_rotation_sigma_rad.y(), 2), 0.0);
     out.covariance += fp.X() * bias_var.asDiagonal() * fp.X().transpose();
     out.time_offset_estimated = with_dt;
     // A variance that could not be computed stays NaN (std::max(0.0, NaN) would make it 0).
@@ -593,8 +584,8 @@ ReferenceFreeCalibration calibrate_reference_free(const std::vector<PhotoObserva
   std::vector<std::vector<Mat3>> implied(P);
   std::vector<Mat3> R_world_board_photo(n);
   for (std::size_t k = 0; k < n; ++k) {
-    R_world_board_photo[k] = device_rotation(track, fp.photo(k).t_shot + fp.dt) * out.R_device_camera *
-                             fp.photo(k).R_camera_board;
+    R_world_board_photo[k] =
+        device_rotation(track, fp.photo(k).t_shot + fp.dt) * out.R_device_camera * fp.photo(k).R_camera_board;
     if (use[k]) implied[fp.group[k]].push_back(R_world_board_photo[k]);
   }
   std::vector<Mat3> R_world_board(P);
@@ -611,10 +602,13 @@ ReferenceFreeCalibration calibrate_reference_free(const std::vector<PhotoObserva
     r.angle_deg = rad2deg(e.norm());
     r.tilt_deg = rad2deg(e_world.head<2>().norm());
     r.heading_deg = rad2deg(e_world.z());
-    r.normalised = e.dot(fp.photo_covariance(k).ldlt().solve(e)) / (out.variance_factor > 0 ? out.variance_factor : 1.0);
+    r.normalised =
+        e.dot(fp.photo_covariance(k).ldlt().solve(e)) / (out.variance_factor > 0 ? out.variance_factor : 1.0);
     r.outlier = !use[k];
-    if (r.outlier) out.outliers.push_back(r.photo);
-    else sum_sq[fp.group[k]] += e.squaredNorm();
+    if (r.outlier)
+      out.outliers.push_back(r.photo);
+    else
+      sum_sq[fp.group[k]] += e.squaredNorm();
     out.residuals.push_back(std::move(r));
   }
   for (std::size_t s = 0; s < P; ++s) {
