@@ -13,9 +13,7 @@ using fixture::make_scene;
 using fixture::SyntheticScene;
 
 // The box's orientation error, its half-turn about the long axis allowed (the outline's symmetry).
-double box_error_deg(const Mat3& R, const Mat3& R_true) {
-  return rad2deg(std::min(rotation_distance(R, R_true), rotation_distance(turned_round(R), R_true)));
-}
+double box_error_deg(const Mat3& R, const Mat3& R_true) { return rad2deg(box_angle(R, R_true)); }
 
 // The projected box's bounding rectangle in a view, widened by `margin` of its size (a user's).
 cv::Rect rectangle_around(const SyntheticScene& s, std::size_t view, const Vec3& size, double margin) {

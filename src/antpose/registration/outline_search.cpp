@@ -8,6 +8,8 @@
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "antpose/registration/pose_selection.hpp"
+
 namespace antpose::registration {
 namespace {
 
@@ -30,12 +32,6 @@ std::vector<Mat3> hanging_orientations(const Vec3& up_board, const OutlineSearch
       for (const double roll : o.roll_deg)
         out.push_back(R_board_level * rot_z(-deg2rad(k * 180.0 / yaws)) * rot_x(-deg2rad(tilt)) * rot_y(deg2rad(roll)));
   return out;
-}
-
-// The angle between two box orientations, the box's own half-turn about its long axis allowed.
-double box_angle(const Mat3& a, const Mat3& b) {
-  const Mat3 b_turned = b * Vec3(-1.0, -1.0, 1.0).asDiagonal();
-  return std::min(rotation_distance(a, b), rotation_distance(a, b_turned));
 }
 
 // The box's corners in the board frame at a pose.

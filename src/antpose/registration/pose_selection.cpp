@@ -58,6 +58,10 @@ Iso3 upright(const Iso3& T_board_antenna, const Vec3& up_board) {
 
 double boresight_angle(const Mat3& a, const Mat3& b) { return angle_between(a.col(1), b.col(1)); }
 
+double box_angle(const Mat3& a, const Mat3& b) {
+  return std::min(rotation_distance(a, b), rotation_distance(a, turned_round(b)));
+}
+
 OptionProblems SelectionOptions::Check() const {
   OptionProblems p;
   p.require(rival_min_deg > 0 && rival_min_deg < 90, "rival_min_deg", "in (0, 90)");

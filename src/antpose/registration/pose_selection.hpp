@@ -45,11 +45,11 @@ enum class FrontBackCue { kNone, kMast, kEvidence };
 std::string to_string(FrontBackCue cue);  // "none", "mast", "evidence"
 
 struct Selection {
-  std::size_t best = 0;                 // index into the candidates; its twin turned round is not among them
-  bool turned = false;                  // the best's twin won front and back: use it turned round
-  std::vector<std::size_t> rivals;      // shape rivals, best first
-  std::vector<std::size_t> near_rivals; // within rival_min_deg, not beaten decisively, best first
-  std::optional<Comparison> runner_up;  // the best against the best distinct other candidate
+  std::size_t best = 0;                  // index into the candidates; its twin turned round is not among them
+  bool turned = false;                   // the best's twin won front and back: use it turned round
+  std::vector<std::size_t> rivals;       // shape rivals, best first
+  std::vector<std::size_t> near_rivals;  // within rival_min_deg, not beaten decisively, best first
+  std::optional<Comparison> runner_up;   // the best against the best distinct other candidate
   FrontBackCue front_back_cue = FrontBackCue::kNone;
   Comparison front_back;         // the chosen side against the other (side units)
   bool front_back_open = false;  // no cue decided
@@ -75,5 +75,9 @@ Iso3 upright(const Iso3& T_board_antenna, const Vec3& up_board);
 
 /// The angle between two poses' boresights (y_a), rad.
 double boresight_angle(const Mat3& R_board_a, const Mat3& R_board_b);
+
+/// The angle between two box orientations, rad, the box's own half-turn about its long axis
+/// allowed (turned_round: the same outline).
+double box_angle(const Mat3& R_board_a, const Mat3& R_board_b);
 
 }  // namespace antpose::registration

@@ -98,11 +98,6 @@ std::vector<Refined> refine_all(const std::shared_ptr<const model::AntennaModel>
   return out;
 }
 
-// The box's orientation angle, its own half-turn about the long axis allowed.
-double box_angle(const Mat3& a, const Mat3& b) {
-  return std::min(rotation_distance(a, b), rotation_distance(a, turned_round(b)));
-}
-
 // Refined candidates that fit the rectangle, one per place: of those ending at the same box pose,
 // the one whose outline fits best. Best outline first.
 std::vector<Refined> distinct_in_rectangle(std::vector<Refined> refined, const model::AntennaModel& model,
