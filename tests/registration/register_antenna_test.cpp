@@ -91,5 +91,29 @@ TEST(RegisterAntenna, ARectangleOnTheSkyFindsNothingAndSaysWhy) {
   EXPECT_NE(r.why_not.find("rectangle"), std::string::npos) << r.why_not;
 }
 
+// Where no pose meets its outline well, the poses that meet it faintly are measured, with a
+// warning; beyond the faint limit nothing is. The limits are set about this scene's own outline.
+TEST(RegisterAntenna, AnOutlineMetOnlyFaintlyIsMeasuredWithAWarning) {
+  const SyntheticScene s = make_scene();
+  AntennaScene scene = antenna_scene(s);
+  scene.mast = s.mast;
+  const auto clear = register_antenna(model::parametric_panel({}), scene, {});
+  ASSERT_TRUE(clear.found) << clear.why_not;
+  EXPECT_TRUE(clear.warnings.empty());
+
+  RegisterOptions o;
+  o.max_outline_score = 0.5 * clear.outline_score;
+  const auto faint = register_antenna(model::parametric_panel({}), scene, o);
+  ASSERT_TRUE(faint.found) << faint.why_not;
+  EXPECT_LT(rad2deg(rotation_distance(faint.T_board_antenna.linear(), s.T_board_antenna.linear())), 1.0);
+  ASSERT_EQ(faint.warnings.size(), 1u);
+  EXPECT_NE(faint.warnings[0].find("only faintly"), std::string::npos) << faint.warnings[0];
+
+  o.max_faint_outline_score = o.max_outline_score;
+  const auto none = register_antenna(model::parametric_panel({}), scene, o);
+  EXPECT_FALSE(none.found);
+  EXPECT_NE(none.why_not.find("fits its outline"), std::string::npos) << none.why_not;
+}
+
 }  // namespace
 }  // namespace antpose::registration

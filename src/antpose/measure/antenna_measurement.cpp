@@ -128,6 +128,7 @@ void apply_registration(AntennaMeasurement& m, const model::AntennaModel& model,
   m.candidates = r.proposed;
   m.registration_candidates = r.candidates;
   m.method = fmt::format("model {}, outline in {} photos + points", model.name, r.outline_views);
+  m.warnings.insert(m.warnings.end(), r.warnings.begin(), r.warnings.end());
   const model::AntennaModel& fitted = r.edge_radius ? r.edge_radius->model : model;
   if (r.edge_radius) m.edge_radius_m = r.edge_radius->radius_m, m.edge_radii_within_m = r.edge_radius->within_m;
   m.model_board = transformed(model::sample_surface(fitted.mesh_antenna, 0.01, 1), r.T_board_antenna);

@@ -135,11 +135,17 @@ void fit_shapes(std::vector<Refined>& kept, const AntennaScene& s, const Registe
   }
 }
 
-// The candidates whose outline meets the photos' edges (max_outline_score, min_outline_views).
-void keep_fitting_outlines(std::vector<Refined>& kept, const RegisterOptions& o) {
-  std::erase_if(kept, [&](const Refined& k) {
-    return k.outline.score > o.max_outline_score || k.outline.views_used < o.min_outline_views;
-  });
+// The candidates whose outline meets the photos' edges (max_outline_score, min_outline_views), or
+// where none does, those that meet them faintly (max_faint_outline_score): true in that case.
+bool keep_fitting_outlines(std::vector<Refined>& kept, const RegisterOptions& o) {
+  const auto fits = [&](const Refined& k, double max_score) {
+    return k.outline.score <= max_score && k.outline.views_used >= o.min_outline_views;
+  };
+  const bool faint =
+      std::none_of(kept.begin(), kept.end(), [&](const Refined& k) { return fits(k, o.max_outline_score); });
+  const double limit = faint ? o.max_faint_outline_score : o.max_outline_score;
+  std::erase_if(kept, [&](const Refined& k) { return !fits(k, limit); });
+  return faint && !kept.empty();
 }
 
 // A rival's pose turned the way the result's front and back were decided: by the mast where it
@@ -249,7 +255,8 @@ OptionProblems RegisterOptions::Check() const {
   p.require(refine_candidates >= 1, "refine_candidates", "at least 1");
   p.require(same_pose_deg >= 0 && same_pose_m >= 0, "same_pose_deg, same_pose_m", "≥ 0");
   p.require(min_roi_fill >= 0 && min_roi_fill <= 1, "min_roi_fill", "in [0, 1]");
-  p.require(max_outline_score > 0 && max_outline_score <= 1, "max_outline_score", "in (0, 1]");
+  p.require(max_outline_score > 0 && max_outline_score <= max_faint_outline_score && max_faint_outline_score <= 1,
+            "max_outline_score, max_faint_outline_score", "0 < max_outline_score ≤ max_faint_outline_score ≤ 1");
   return p;
 }
 
@@ -290,7 +297,7 @@ AntennaRegistration register_antenna(const model::AntennaModel& model, const Ant
   const auto shared = std::make_shared<const model::AntennaModel>(model);
   auto kept = distinct_in_rectangle(refine_all(shared, s, proposals, o), model, s, o);
   fit_shapes(kept, s, o);
-  keep_fitting_outlines(kept, o);
+  const bool faint = keep_fitting_outlines(kept, o);
   if (kept.empty()) {
     AntennaRegistration none;
     none.proposed = proposals.size();
@@ -309,6 +316,12 @@ AntennaRegistration register_antenna(const model::AntennaModel& model, const Ant
   }
   auto out = select(s, std::move(kept), o);
   out.proposed = proposals.size();
+  if (faint)
+    out.warnings.push_back(fmt::format(
+        "the model's outline meets the photos' edges only faintly (score {:.2f}; a clearly seen antenna scores "
+        "under {:.2f}): its edges are faint against the background or partly hidden; the σ carries the poor fit, "
+        "but check the model drawn over the photos",
+        out.outline_score, o.max_outline_score));
   return out;
 }
 

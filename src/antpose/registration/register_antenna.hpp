@@ -11,8 +11,9 @@
 // A candidate must fit the user's rectangle: its box, projected into the rectangle's photo, covers
 // at least `min_roi_fill` of it and has its centre inside it (the rectangle was drawn around this
 // antenna, so a pose on a neighbour or the mast does not qualify); and its outline must meet the
-// photos' edges (max_outline_score, min_outline_views). "Not found" is a value: the
-// result says why and what photo or rectangle would help.
+// photos' edges (max_outline_score, min_outline_views; faintly, max_faint_outline_score, where no
+// pose meets them well). "Not found" is a value: the result says why and what photo or rectangle
+// would help.
 #pragma once
 
 #include <cstddef>
@@ -68,10 +69,15 @@ struct RegisterOptions {
   std::size_t shape_candidates = 3;                // that many, by their outline
   double same_pose_deg = 2.0, same_pose_m = 0.03;  // refined candidates this close are one
   double min_roi_fill = 0.3;
-  /// A pose whose outline misses its edges this much (SilhouetteResult::score: half of the outline
-  /// without an edge within the cutoff scores 0.5) in fewer than `min_outline_views` photos fits
-  /// no object: a rectangle on the sky, or the wrong model.
+  /// A pose fits its outline where SilhouetteResult::score is at most `max_outline_score` (half of
+  /// the outline without an edge within the cutoff scores 0.5) in at least `min_outline_views`
+  /// photos. Where no pose does, the antenna's edges may still be faint against the background
+  /// (a grey radome before cloud) or partly hidden (a neighbour, foliage): the poses up to
+  /// `max_faint_outline_score` are kept, the outline covariance widens with their residuals, and
+  /// the result says so. Beyond that, under about a quarter of the outline meets an edge: no
+  /// object (a rectangle on the sky) or the wrong model.
   double max_outline_score = 0.5;
+  double max_faint_outline_score = 0.8;
   std::size_t min_outline_views = 3;
   OptionProblems Check() const;
 };
@@ -93,7 +99,7 @@ struct AntennaRegistration {
   double outline_score = 1.0, outline_rms_px = 0.0;
   std::size_t outline_views = 0;
   RegistrationVerdict verdict = RegistrationVerdict::kUnique;
-  std::vector<Iso3> rivals;  // other poses the evidence does not rule out (front and back as decided)
+  std::vector<Iso3> rivals;       // other poses the evidence does not rule out (front and back as decided)
   std::vector<Iso3> near_rivals;  // poses within a few degrees it does not rule out: the σ covers them
   Selection selection;
   std::vector<PoseCandidate> candidates;  // refined, distinct, with their evidence
