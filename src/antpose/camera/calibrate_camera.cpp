@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <ctime>
 #include <limits>
 #include <set>
 
@@ -101,8 +100,9 @@ class FsSettings {
 // tutorial's defaults are 50 and 25), with a warning.
 double square_in_metres(double v, const char* name, const fs::path& file, bool in_mm, Diagnostics& diagnostics) {
   if (in_mm) {
-    diagnostics.warn(file, 0, fmt::format("<{}> {} read as millimetres (= {} m); give metres to avoid this guess",
-                                          name, v, v / 1000.0));
+    diagnostics.warn(
+        file, 0,
+        fmt::format("<{}> {} read as millimetres (= {} m); give metres to avoid this guess", name, v, v / 1000.0));
     return v / 1000.0;
   }
   return v;
@@ -118,8 +118,9 @@ CalibrationSettings read_opencv_settings(const fs::path& file, Diagnostics& diag
   }
   const cv::FileNode node = storage["Settings"];
   if (node.empty() || !node.isMap())
-    throw InputError(file, "no <Settings> element, expected the settings of OpenCV's camera calibration sample "
-                           "(<opencv_storage><Settings>...</Settings></opencv_storage>)");
+    throw InputError(file,
+                     "no <Settings> element, expected the settings of OpenCV's camera calibration sample "
+                     "(<opencv_storage><Settings>...</Settings></opencv_storage>)");
   const FsSettings s(node, file);
   CalibrationSettings out;
   out.board_source = file;
@@ -127,13 +128,19 @@ CalibrationSettings read_opencv_settings(const fs::path& file, Diagnostics& diag
   BoardSpec b;
   b.cols = s.integer("BoardSize_Width", 2, 1000, "inner corners, circles or squares per row");
   b.rows = s.integer("BoardSize_Height", 2, 1000, "inner corners, circles or squares per column");
-  const std::string pattern_expected = "\"CHESSBOARD\", \"CIRCLES_GRID\", \"ASYMMETRIC_CIRCLES_GRID\" or \"CHARUCOBOARD\"";
+  const std::string pattern_expected =
+      "\"CHESSBOARD\", \"CIRCLES_GRID\", \"ASYMMETRIC_CIRCLES_GRID\" or \"CHARUCOBOARD\"";
   const std::string pattern = s.text("Calibrate_Pattern", pattern_expected);
-  if (pattern == "CHESSBOARD") b.type = BoardType::kChessboard;
-  else if (pattern == "CIRCLES_GRID") b.type = BoardType::kCircles;
-  else if (pattern == "ASYMMETRIC_CIRCLES_GRID") b.type = BoardType::kAsymmetricCircles;
-  else if (pattern == "CHARUCOBOARD") b.type = BoardType::kCharuco;
-  else s.fail("Calibrate_Pattern", s.shown("Calibrate_Pattern"), pattern_expected);
+  if (pattern == "CHESSBOARD")
+    b.type = BoardType::kChessboard;
+  else if (pattern == "CIRCLES_GRID")
+    b.type = BoardType::kCircles;
+  else if (pattern == "ASYMMETRIC_CIRCLES_GRID")
+    b.type = BoardType::kAsymmetricCircles;
+  else if (pattern == "CHARUCOBOARD")
+    b.type = BoardType::kCharuco;
+  else
+    s.fail("Calibrate_Pattern", s.shown("Calibrate_Pattern"), pattern_expected);
   if (b.type == BoardType::kCharuco && (b.cols < 3 || b.rows < 3))
     throw InputError(file, fmt::format("<BoardSize_Width>x<BoardSize_Height> is {}x{}, expected at least 3x3 squares "
                                        "for a ChArUco board",
@@ -169,8 +176,9 @@ CalibrationSettings read_opencv_settings(const fs::path& file, Diagnostics& diag
   out.zero_tangent = s.flag("Calibrate_AssumeZeroTangentialDistortion", false);
   out.fix_principal_point = s.flag("Calibrate_FixPrincipalPointAtTheCenter", false);
   if (s.flag("Calibrate_UseFisheyeModel", false))
-    throw InputError(file, "<Calibrate_UseFisheyeModel> is 1, but antpose models phone lenses with OpenCV's "
-                           "5-coefficient (k1, k2, p1, p2, k3) model; expected 0");
+    throw InputError(file,
+                     "<Calibrate_UseFisheyeModel> is 1, but antpose models phone lenses with OpenCV's "
+                     "5-coefficient (k1, k2, p1, p2, k3) model; expected 0");
   const bool k1 = s.flag("Fix_K1", false), k2 = s.flag("Fix_K2", false), k3 = s.flag("Fix_K3", false);
   s.flag("Fix_K4", true);  // rational-model coefficients: not estimated in the 5-coefficient model
   s.flag("Fix_K5", true);
@@ -179,8 +187,8 @@ CalibrationSettings read_opencv_settings(const fs::path& file, Diagnostics& diag
   if (s.has("Input") && !node["Input"].isString() && !node["Input"].isInt())
     s.fail("Input", s.shown("Input"), "a camera id, video or image-list file name");
   if (s.has("Input_Delay")) s.integer("Input_Delay", 0, 1000000, "ms between frames");
-  for (const char* name : {"Write_DetectedFeaturePoints", "Write_extrinsicParameters", "Write_gridPoints",
-                           "Show_UndistortedImage"})
+  for (const char* name :
+       {"Write_DetectedFeaturePoints", "Write_extrinsicParameters", "Write_gridPoints", "Show_UndistortedImage"})
     s.flag(name, false);
   if (s.has("Write_outputFileName")) s.text("Write_outputFileName", "a file name");
   return out;
@@ -214,8 +222,9 @@ void check_keys(const YAML::Node& map, const std::set<std::string>& known, const
 CalibrationSettings read_yaml_settings(const fs::path& file, const std::string& text, Diagnostics& diagnostics) {
   const YAML::Node d = io::load_yaml(text, file);
   if (!d.IsMap())
-    throw InputError(file, "expected a YAML map of calibration settings (board, fix_aspect_ratio, ...) or an OpenCV "
-                           "<opencv_storage><Settings> file");
+    throw InputError(file,
+                     "expected a YAML map of calibration settings (board, fix_aspect_ratio, ...) or an OpenCV "
+                     "<opencv_storage><Settings> file");
   check_keys(d,
              {"board", "fix_aspect_ratio", "zero_tangent_distortion", "fix_principal_point", "distortion_coefficients",
               "intrinsics_guess", "flip_vertical", "max_images", "detection", "robust"},
@@ -223,7 +232,8 @@ CalibrationSettings read_yaml_settings(const fs::path& file, const std::string& 
   CalibrationSettings s;
   s.board_source = file;
   if (const YAML::Node b = d["board"]) {
-    if (!b.IsMap()) throw InputError(file, io::line_of(b), "board is " + io::show(b) + ", expected a map as board.yaml");
+    if (!b.IsMap())
+      throw InputError(file, io::line_of(b), "board is " + io::show(b) + ", expected a map as board.yaml");
     try {
       s.board = parse_board(YAML::Dump(b), file);
     } catch (const InputError& e) {
@@ -267,11 +277,11 @@ CalibrationSettings read_yaml_settings(const fs::path& file, const std::string& 
   }
   if (const YAML::Node det = d["detection"]) {
     if (!det.IsMap()) throw InputError(file, io::line_of(det), "detection is " + io::show(det) + ", expected a map");
-    check_keys(det,
-               {"adaptive_threshold", "normalize_image", "fast_check", "filter_quads", "subpix_window",
-                "subpix_iterations", "subpix_epsilon", "min_laplacian_variance", "border_margin_px",
-                "charuco_min_corners", "charuco_camera_pass"},
-               file, "detection.");
+    check_keys(
+        det,
+        {"adaptive_threshold", "normalize_image", "fast_check", "filter_quads", "subpix_window", "subpix_iterations",
+         "subpix_epsilon", "min_laplacian_variance", "border_margin_px", "charuco_min_corners", "charuco_camera_pass"},
+        file, "detection.");
     auto& o = s.detection;
     auto flag = [&](const char* k, bool& v) {
       if (const YAML::Node n = det[k]) v = yaml_bool(n, file, std::string("detection.") + k);
@@ -431,9 +441,10 @@ CameraCalibrationResult calibrate_views(const std::vector<CalibrationView>& view
       continue;
     }
     if (settings.max_images > 0 && taken >= settings.max_images) {
-      im.reason = fmt::format("not used: the first {} usable photos were enough (max_images / "
-                              "Calibrate_NrOfFrameToUse)",
-                              settings.max_images);
+      im.reason = fmt::format(
+          "not used: the first {} usable photos were enough (max_images / "
+          "Calibrate_NrOfFrameToUse)",
+          settings.max_images);
       continue;
     }
     active[i] = true;
@@ -477,8 +488,8 @@ CameraCalibrationResult calibrate_views(const std::vector<CalibrationView>& view
     cv::Mat sd_intr, sd_extr, per_view;
     double rms = 0.0;
     try {
-      rms = cv::calibrateCamera(obj, img, cv::Size(width, height), K, D, rvecs, tvecs, sd_intr, sd_extr,
-                                        per_view, flags.flags);
+      rms = cv::calibrateCamera(obj, img, cv::Size(width, height), K, D, rvecs, tvecs, sd_intr, sd_extr, per_view,
+                                flags.flags);
     } catch (const cv::Exception& e) {
       throw MeasurementError(fmt::format("camera calibration: cv::calibrateCamera failed: {}", e.err));
     }
@@ -518,9 +529,10 @@ CameraCalibrationResult calibrate_views(const std::vector<CalibrationView>& view
       active[i] = false;
       auto& im = images[i];
       im.used = false;
-      im.reason = fmt::format("reprojection outlier: RMS {:.3f} px > {:.3f} px (max of {:g} × median {:.3f} px and "
-                              "{:g} px)",
-                              *im.rms_px, limit, settings.outlier_factor, med, settings.outlier_min_px);
+      im.reason = fmt::format(
+          "reprojection outlier: RMS {:.3f} px > {:.3f} px (max of {:g} × median {:.3f} px and "
+          "{:g} px)",
+          *im.rms_px, limit, settings.outlier_factor, med, settings.outlier_min_px);
     }
     if (round >= 10) throw MeasurementError("camera calibration: outlier rejection did not settle in 10 rounds");
   }
@@ -538,12 +550,12 @@ CameraCalibrationResult calibrate_camera(const Capture& capture, const Calibrati
   if (settings.board) {
     board = *settings.board;
     if (board_file && format_board(*board_file) != format_board(board))
-      diagnostics.warn(settings.board_source, 0,
-                       fmt::format("the settings' board ({} {}x{}, square {} m) differs from {} ({} {}x{}, square {} "
-                                   "m); using the settings' board",
-                                   to_string(board.type), board.cols, board.rows, board.square_m, board_path.string(),
-                                   to_string(board_file->type), board_file->cols, board_file->rows,
-                                   board_file->square_m));
+      diagnostics.warn(
+          settings.board_source, 0,
+          fmt::format("the settings' board ({} {}x{}, square {} m) differs from {} ({} {}x{}, square {} "
+                      "m); using the settings' board",
+                      to_string(board.type), board.cols, board.rows, board.square_m, board_path.string(),
+                      to_string(board_file->type), board_file->cols, board_file->rows, board_file->square_m));
   } else if (board_file) {
     board = *board_file;
   } else {
@@ -632,143 +644,6 @@ CameraCalibrationResult calibrate_camera(const fs::path& folder, const Calibrati
   return calibrate_camera(read_capture(folder, diagnostics), settings, diagnostics, progress);
 }
 
-// ---------------------------------------------------------------------------------------------
-// Camera file
-
-std::string format_camera_file(const CameraCalibrationResult& r) {
-  cv::FileStorage out(".yaml", cv::FileStorage::WRITE | cv::FileStorage::MEMORY);
-  char when[128] = {};
-  const std::time_t now = std::time(nullptr);
-  std::tm tm{};
-  gmtime_r(&now, &tm);
-  std::strftime(when, sizeof when, "%a %d %b %Y %H:%M:%S UTC", &tm);
-  std::vector<std::size_t> used;
-  for (std::size_t i = 0; i < r.images.size(); ++i)
-    if (r.images[i].used) used.push_back(i);
-  out << "calibration_time" << when;
-  out << "nr_of_frames" << static_cast<int>(used.size());
-  out << "image_width" << r.intrinsics.width;
-  out << "image_height" << r.intrinsics.height;
-  out << "board_width" << r.board.cols;
-  out << "board_height" << r.board.rows;
-  out << "square_size" << r.board.square_m;
-  out << "board_type" << to_string(r.board.type);
-  if (r.board.type == BoardType::kCharuco) {
-    out << "marker_size" << r.board.marker_m;
-    out << "aruco_dictionary" << r.board.dictionary;
-  }
-  if (r.flags & cv::CALIB_FIX_ASPECT_RATIO) out << "fix_aspect_ratio" << r.intrinsics.fx / r.intrinsics.fy;
-  std::string names;
-  for (const auto& n : r.flag_names) names += (names.empty() ? "" : " + ") + n;
-  out.writeComment("flags: " + (names.empty() ? std::string("none") : names));
-  out << "flags" << r.flags;
-  cv::Mat K;
-  cv::eigen2cv(Mat3(r.intrinsics.K()), K);
-  out << "camera_matrix" << K;
-  cv::Mat D(5, 1, CV_64F);
-  for (int k = 0; k < 5; ++k) D.at<double>(k) = r.intrinsics.distortion[static_cast<std::size_t>(k)];
-  out << "distortion_coefficients" << D;
-  out << "avg_reprojection_error" << r.rms_px;
-  cv::Mat per_view(static_cast<int>(used.size()), 1, CV_64F), extr(static_cast<int>(used.size()), 6, CV_64F);
-  for (std::size_t j = 0; j < used.size(); ++j) {
-    const auto& im = r.images[used[j]];
-    per_view.at<double>(static_cast<int>(j)) = im.rms_px.value_or(0.0);
-    for (int k = 0; k < 3; ++k) {
-      extr.at<double>(static_cast<int>(j), k) = im.rvec[k];
-      extr.at<double>(static_cast<int>(j), 3 + k) = im.tvec[k];
-    }
-  }
-  if (!used.empty()) {
-    out << "per_view_reprojection_errors" << per_view;
-    out.writeComment("a set of 6-tuples (rotation vector + translation vector) for each view");
-    out << "extrinsic_parameters" << extr;
-  }
-  out << "images" << "[";
-  for (std::size_t i : used) out << r.images[i].image;
-  out << "]";
-  cv::Mat sd_k = (cv::Mat_<double>(4, 1) << r.sigma.fx, r.sigma.fy, r.sigma.cx, r.sigma.cy);
-  cv::Mat sd_d(5, 1, CV_64F);
-  for (int k = 0; k < 5; ++k) sd_d.at<double>(k) = r.sigma.distortion[static_cast<std::size_t>(k)];
-  out.writeComment("1-sigma standard deviations from calibrateCameraExtended: fx, fy, cx, cy; k1, k2, p1, p2, k3");
-  out << "camera_matrix_std_dev" << sd_k;
-  out << "distortion_coefficients_std_dev" << sd_d;
-  out << "rejected_images" << "[";
-  for (const auto& im : r.images)
-    if (!im.used) out << "{" << "image" << im.image << "reason" << im.reason << "}";
-  out << "]";
-  return out.releaseAndGetString();
-}
-
-void write_camera_file(const fs::path& file, const CameraCalibrationResult& result, bool force) {
-  if (!force && fs::exists(file))
-    throw InputError(file, "exists already; pass --force to replace it");
-  io::write_text_atomic(file, format_camera_file(result));
-}
-
-CameraFile read_camera_file(const fs::path& file) {
-  if (!fs::exists(file)) throw InputError(file, "camera file not found");
-  cv::FileStorage in;
-  try {
-    if (!in.open(file.string(), cv::FileStorage::READ))
-      throw InputError(file, "cannot open it as an OpenCV FileStorage (YAML/XML) camera file");
-  } catch (const cv::Exception& e) {
-    throw InputError(file, fmt::format("not a valid OpenCV FileStorage camera file ({})", e.err));
-  }
-  CameraFile c;
-  auto integer = [&](const char* name) {
-    const cv::FileNode n = in[name];
-    if (n.empty() || !n.isInt())
-      throw InputError(file, fmt::format("{} is {}, expected a positive integer (pixels)", name,
-                                         n.empty() ? "missing" : "not an integer"));
-    const int v = static_cast<int>(n);
-    if (v <= 0 || v > 100000) throw InputError(file, fmt::format("{} is {}, expected a positive number of pixels", name, v));
-    return v;
-  };
-  c.intrinsics.width = integer("image_width");
-  c.intrinsics.height = integer("image_height");
-  cv::Mat K, D;
-  try {
-    in["camera_matrix"] >> K;
-    in["distortion_coefficients"] >> D;
-  } catch (const cv::Exception& e) {
-    throw InputError(file, fmt::format("camera_matrix / distortion_coefficients unreadable ({})", e.err));
-  }
-  if (K.rows != 3 || K.cols != 3)
-    throw InputError(file, fmt::format("camera_matrix is {}, expected a 3x3 !!opencv-matrix",
-                                       K.empty() ? std::string("missing") : fmt::format("{}x{}", K.rows, K.cols)));
-  K.convertTo(K, CV_64F);
-  if (K.at<double>(0, 1) != 0.0 || K.at<double>(1, 0) != 0.0 || K.at<double>(2, 0) != 0.0 ||
-      K.at<double>(2, 1) != 0.0 || K.at<double>(2, 2) != 1.0)
-    throw InputError(file, "camera_matrix is not of the form [fx 0 cx; 0 fy cy; 0 0 1] (skew is not supported)");
-  c.intrinsics.fx = K.at<double>(0, 0);
-  c.intrinsics.fy = K.at<double>(1, 1);
-  c.intrinsics.cx = K.at<double>(0, 2);
-  c.intrinsics.cy = K.at<double>(1, 2);
-  if (D.empty()) throw InputError(file, "distortion_coefficients is missing, expected 4 or 5 numbers");
-  D.convertTo(D, CV_64F);
-  const std::size_t nd = D.total();
-  if (nd != 4 && nd != 5 && nd != 8 && nd != 12 && nd != 14)
-    throw InputError(file, fmt::format("distortion_coefficients has {} entries, expected 4, 5, 8, 12 or 14", nd));
-  for (std::size_t k = 0; k < nd; ++k) {
-    const double v = D.at<double>(static_cast<int>(k));
-    if (k < 5) c.intrinsics.distortion[k] = v;
-    else if (v != 0.0)
-      throw InputError(file, fmt::format("distortion_coefficients[{}] is {}, but antpose uses the 5-coefficient model "
-                                         "(k1, k2, p1, p2, k3); expected 0",
-                                         k, v));
-  }
-  if (const auto bad = c.intrinsics.invalid_reason()) throw InputError(file, "invalid intrinsics: " + *bad);
-  if (const cv::FileNode e = in["avg_reprojection_error"]; !e.empty() && (e.isReal() || e.isInt()))
-    c.rms_px = static_cast<double>(e);
-  if (const cv::FileNode n = in["camera_matrix_std_dev"]; !n.empty()) {
-    cv::Mat sd;
-    n >> sd;
-    if (sd.total() == 4 && sd.type() == CV_64F && sd.at<double>(2) >= 0 && sd.at<double>(3) >= 0)
-      c.principal_point_sigma_px = Vec2(sd.at<double>(2), sd.at<double>(3));
-  }
-  return c;
-}
-
 ProfileCamera profile_camera(const CameraCalibrationResult& r) {
   return {r.intrinsics, r.rms_px, Vec2(r.sigma.cx, r.sigma.cy)};
 }
@@ -777,8 +652,10 @@ std::string describe(const CameraCalibrationResult& r) {
   std::string s = fmt::format("{:<28} {:>6}  {}\n", "image", "points", "RMS px / reason");
   for (const auto& im : r.images) {
     std::string what;
-    if (im.used) what = fmt::format("{:.4f}", im.rms_px.value_or(0.0));
-    else what = "refused: " + im.reason;
+    if (im.used)
+      what = fmt::format("{:.4f}", im.rms_px.value_or(0.0));
+    else
+      what = "refused: " + im.reason;
     if (im.used && !im.reason.empty()) what += "  (" + im.reason + ")";
     s += fmt::format("{:<28} {:>6}  {}\n", im.image, im.points, what);
   }
