@@ -88,5 +88,32 @@ TEST(PoseEvidence, TheTruePoseBeatsAnotherYawDecisively) {
   EXPECT_FALSE(compare_shape(truth, turned, judge.options()).decisive);
 }
 
+// Where one long side of the panel is as bright as what lies behind it, that stretch of its
+// outline has no edge: the outline's cost counts its samples as misses, the placement leaves them
+// out and stays what it was.
+TEST(PoseEvidence, AFaintStretchOfOutlineCostsButDoesNotMisplace) {
+  const SyntheticScene s = make_scene();
+  const auto model = model::parametric_panel({});
+  SilhouetteOptions o;
+  o.outline_box_m = model.size_m;
+  const auto seen = evaluate_outline(model.mesh_antenna, s.T_board_antenna, s.views, s.intrinsics, o);
+  std::vector<SilhouetteView> faint = s.views;
+  for (auto& v : faint) {
+    const auto centre = s.intrinsics.project(v.R_camera_board * s.T_board_antenna.translation() + v.t_camera_board);
+    ASSERT_TRUE(centre);
+    v.image = v.image.clone();
+    const int from = static_cast<int>(centre->x());
+    v.image.colRange(from, v.image.cols).setTo(128);  // the panel's right half and its background alike
+  }
+  const auto half = evaluate_outline(model.mesh_antenna, s.T_board_antenna, faint, s.intrinsics, o);
+  ASSERT_EQ(half.cost.size(), seen.cost.size());
+  for (std::size_t i = 0; i < seen.cost.size(); ++i) {
+    SCOPED_TRACE(i);
+    EXPECT_LT(seen.placement[i], 0.1);
+    EXPECT_GT(half.cost[i], seen.cost[i] + 0.25) << "the faint side's samples are misses";
+    EXPECT_LT(half.placement[i], seen.placement[i] + 0.05) << "the edges it meets lie where they did";
+  }
+}
+
 }  // namespace
 }  // namespace antpose::registration

@@ -52,6 +52,30 @@ TEST(PoseSelection, ANearPoseThePhotosDoNotRuleOutIsANearRival) {
   EXPECT_EQ(s.near_rivals[0], 1u);
 }
 
+// Where a stretch of the true outline is too faint to be seen, a pose a few degrees off that lays
+// its outline on the crease beside it meets more edges and costs less in every photo alike; the
+// edges it meets lie worse on it. That lower cost does not rule out the pose whose outline lies
+// better on what it meets: a near rival. One whose placement is no better is left alone.
+TEST(PoseSelection, ANearPoseThatMeetsItsEdgesBetterIsANearRival) {
+  auto with_placement = [](PoseCandidate c, std::vector<double> placement) {
+    c.evidence.placement = std::move(placement);
+    return c;
+  };
+  const std::vector<PoseCandidate> candidates{
+      with_placement(facing(40, Vec3::Zero(), {0.14, 0.12, 0.13, 0.12, 0.12, 0.12}),
+                     {0.12, 0.10, 0.11, 0.10, 0.09, 0.08}),
+      with_placement(facing(48, Vec3::Zero(), {0.38, 0.34, 0.28, 0.24, 0.27, 0.14}),
+                     {0.10, 0.05, 0.09, 0.07, 0.06, 0.07}),  // fewer edges, better placed
+      with_placement(facing(34, Vec3::Zero(), {0.38, 0.34, 0.28, 0.24, 0.27, 0.14}),
+                     {0.16, 0.12, 0.15, 0.14, 0.11, 0.12})};  // fewer edges, placed no better
+  const std::vector<PoseEvidence> twins(candidates.size(), side({0.0, 0.0}));
+  EXPECT_TRUE(compare_shape(candidates[0].evidence, candidates[1].evidence, {}).decisive);
+  const Selection s = select_pose(candidates, twins, std::nullopt, {}, {});
+  EXPECT_EQ(s.best, 0u);
+  ASSERT_EQ(s.near_rivals.size(), 1u);
+  EXPECT_EQ(s.near_rivals[0], 1u);
+}
+
 TEST(PoseSelection, AMastBehindDecidesFrontAndBackWhateverTheDowntilt) {
   // The panel 0.4 m north of the mast; as registered it faces south, at its mast: turned round
   // it faces north, away from it. An uptilt as registered changes nothing.

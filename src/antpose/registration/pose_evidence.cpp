@@ -104,6 +104,10 @@ Comparison compare_shape(const PoseEvidence& better, const PoseEvidence& other, 
                  o);
 }
 
+Comparison compare_placement(const PoseEvidence& better, const PoseEvidence& other, const EvidenceOptions& o) {
+  return combine({{paired(better.placement, other.placement), 1.0}}, o);
+}
+
 Comparison compare_side(const PoseEvidence& better, const PoseEvidence& other, const EvidenceOptions& o) {
   return combine({{paired(better.mount, other.mount), o.side_mount_weight},
                   {paired(better.mount_outline, other.mount_outline), o.side_mount_outline_weight}},
@@ -172,6 +176,7 @@ PoseEvidence EvidenceJudge::operator()(const Iso3& T_board_antenna) const {
   const auto outline =
       evaluate_outline(model_.mesh_antenna, T_board_antenna, *scene_.views, scene_.intrinsics, options_.outline);
   out.outline = outline.cost;
+  out.placement = outline.placement;
   judge_points(T_board_antenna, out);
   return out;
 }

@@ -29,6 +29,15 @@
 // rival. The units' scatter includes every error common to a unit that a pixel-noise likelihood
 // would miss (a model unlike the real panel, clutter, partial occlusion), so a difference the
 // photos do not agree on is never taken for evidence.
+//
+// One error is common to every photo and escapes that scatter: a face about as bright as what
+// lies behind it (a sunlit side face or end cap against a bright sky, a shaded one against dark
+// trees) leaves that stretch of the true outline without an edge, and a pose a few degrees off
+// that lays its outline on the crease between that face and the next meets an edge at every
+// sample. Its outline then costs less in every photo alike although the edges it meets lie
+// worse on it. So the outline's cost is also kept without the samples that found no edge (the
+// placement), and a pose whose placement is better than the winner's is not ruled out by the
+// winner's lower score (pose_selection.hpp).
 #pragma once
 
 #include <cstddef>
@@ -63,6 +72,7 @@ struct EvidenceOptions {
 /// Per unit; NaN where a unit says nothing (a photo that shows none of the outline, an empty slice).
 struct PoseEvidence {
   std::vector<double> outline;        // per photo
+  std::vector<double> placement;      // per photo: the outline's cost over the samples that found an edge
   std::vector<double> points;         // per slice
   std::vector<double> mount;          // per slice
   std::vector<double> mount_outline;  // per photo: the best vertical cylinder's outline cost behind the pose
@@ -77,8 +87,10 @@ struct Comparison {
   bool decisive = false;
 };
 
-/// The two comparisons of the file comment: of the shape units, and of the side units.
+/// The comparisons of the file comment: of the shape units, of the outline's placement alone (the
+/// photos), and of the side units.
 Comparison compare_shape(const PoseEvidence& better, const PoseEvidence& other, const EvidenceOptions& options);
+Comparison compare_placement(const PoseEvidence& better, const PoseEvidence& other, const EvidenceOptions& options);
 Comparison compare_side(const PoseEvidence& better, const PoseEvidence& other, const EvidenceOptions& options);
 
 /// The scene a model's poses are judged in: the photos (with known objects as occluders and

@@ -23,6 +23,14 @@ std::optional<bool> faces_away_from(const reconstruction::Mast& mast, const Iso3
   return std::nullopt;
 }
 
+// Whether the outline of `other` lies better on the edges it meets than that of `best` by more than
+// the comparison's own standard error: the placement then speaks against a lower score that owes
+// to edges `best` meets and `other` does not (pose_evidence.hpp).
+bool placement_leans_to(const PoseEvidence& other, const PoseEvidence& best, const EvidenceOptions& evidence) {
+  const Comparison c = compare_placement(best, other, evidence);
+  return c.units > 1 && c.difference < -c.standard_error;
+}
+
 }  // namespace
 
 std::string to_string(FrontBackCue cue) {
@@ -90,7 +98,8 @@ Selection select_pose(const std::vector<PoseCandidate>& candidates, const std::v
     const Comparison versus = compare_shape(candidates[s.best].evidence, c.evidence, evidence);
     // The same answer a few degrees off, or another: a boresight elsewhere.
     if (angle <= rival_min) {
-      if (!versus.decisive) s.near_rivals.push_back(order[k]);
+      if (!versus.decisive || placement_leans_to(c.evidence, candidates[s.best].evidence, evidence))
+        s.near_rivals.push_back(order[k]);
       continue;
     }
     if (!s.runner_up) s.runner_up = versus;

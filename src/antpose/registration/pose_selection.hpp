@@ -5,7 +5,10 @@
 // back) and that the winner does not beat decisively is a rival — the photos and points do not
 // tell the two apart, and the answer must say so (a σ that covers both, or a refusal). A nearer
 // candidate the winner does not beat decisively (another local minimum a few degrees off) is the
-// same answer, but the σ must cover it too: a near rival.
+// same answer, but the σ must cover it too: a near rival. So is a nearer candidate whose outline
+// lies better on the edges it meets than the winner's, by more than that comparison's standard
+// error (pose_evidence.hpp: where part of the true outline is too faint to be seen, a pose laying
+// its outline on a crease meets more edges and scores lower in every photo alike).
 // Then front and back, which the box's outline cannot tell: the winner against its twin turned
 // by 180° about its long axis. A known mast decides first where it stands clearly behind one of
 // them (a panel's back plate faces its mount); otherwise the side units (the vertical structure
@@ -48,7 +51,7 @@ struct Selection {
   std::size_t best = 0;                  // index into the candidates; its twin turned round is not among them
   bool turned = false;                   // the best's twin won front and back: use it turned round
   std::vector<std::size_t> rivals;       // shape rivals, best first
-  std::vector<std::size_t> near_rivals;  // within rival_min_deg, not beaten decisively, best first
+  std::vector<std::size_t> near_rivals;  // within rival_min_deg, not ruled out (file comment), best first
   std::optional<Comparison> runner_up;   // the best against the best distinct other candidate
   FrontBackCue front_back_cue = FrontBackCue::kNone;
   Comparison front_back;         // the chosen side against the other (side units)

@@ -374,6 +374,8 @@ OutlineEvaluation evaluate_outline(const model::Mesh& mesh_antenna, const Iso3& 
     for (const auto& smp : g.per_view[i]) sum += edge_cost(smp.r, options);
     const double unfound = static_cast<double>(c.candidates - g.per_view[i].size());
     out.cost.push_back(c.candidates ? (sum + unfound) / static_cast<double>(c.candidates) : nan);
+    const auto found = static_cast<double>(g.per_view[i].size());
+    out.placement.push_back(found > 0 ? sum / found : nan);
     out.samples.push_back(c.candidates);
   }
   out.score = score(g, options);

@@ -184,9 +184,12 @@ SilhouetteResult refine_by_silhouette(const model::Mesh& mesh_antenna, const Iso
 /// selection compares between poses (registration/pose_evidence.hpp). Costs as
 /// SilhouetteResult::score (the mean truncated edge cost, 0 .. 1) over each photo's samples at
 /// full resolution with the fine search; NaN where a photo shows none of that outline (hidden,
-/// out of view), of the box's outline (options.outline_box_m).
+/// out of view), of the box's outline (options.outline_box_m). A sample that finds no edge costs
+/// as much as one far from its edge; `placement` leaves those out: how well the edges a pose
+/// meets lie on its outline, whatever the share of its outline that is too faint to be seen.
 struct OutlineEvaluation {
   std::vector<double> cost;          // per view
+  std::vector<double> placement;     // per view: the mean cost of the samples that found an edge; NaN: none did
   std::vector<std::size_t> samples;  // per view: its samples (measured or not)
   double score = 1;                  // over all views, as SilhouetteResult's
 };
