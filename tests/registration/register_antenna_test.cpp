@@ -1,5 +1,6 @@
 #include "antpose/registration/register_antenna.hpp"
 
+#include <algorithm>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -89,6 +90,28 @@ TEST(RegisterAntenna, ARectangleOnTheSkyFindsNothingAndSaysWhy) {
   const auto r = register_antenna(model::parametric_panel({}), scene, {});
   EXPECT_FALSE(r.found);
   EXPECT_NE(r.why_not.find("rectangle"), std::string::npos) << r.why_not;
+}
+
+// A second registration in a scene that knows more (here the mast) starts from the first's
+// candidates: those whose rounding was profiled keep that profile, and the answer stays.
+TEST(RegisterAntenna, ASecondRegistrationKeepsTheProfiledRounding) {
+  const SyntheticScene s = make_scene();
+  AntennaScene scene = antenna_scene(s);
+  const auto first = register_antenna(model::parametric_panel({}), scene, {});
+  ASSERT_TRUE(first.found) << first.why_not;
+  ASSERT_TRUE(first.edge_radius && first.edge_radius->fitted);
+  const auto profiled = std::count_if(first.candidates.begin(), first.candidates.end(),
+                                      [](const PoseCandidate& c) { return c.edge_radius != nullptr; });
+  EXPECT_GE(profiled, 1);
+  scene.mast = s.mast;
+  const auto second = register_antenna(model::parametric_panel({}), scene, {}, first.candidates);
+  ASSERT_TRUE(second.found) << second.why_not;
+  ASSERT_TRUE(second.edge_radius);
+  EXPECT_EQ(second.edge_radius->radius_m, first.edge_radius->radius_m);
+  EXPECT_EQ(second.edge_radius->scores, first.edge_radius->scores) << "the profile is the first's";
+  EXPECT_LT(rad2deg(rotation_distance(second.T_board_antenna.linear(), s.T_board_antenna.linear())), 1.0);
+  EXPECT_NEAR(second.rotation_covariance_board.trace(), first.rotation_covariance_board.trace(),
+              0.5 * first.rotation_covariance_board.trace());
 }
 
 // Where no pose meets its outline well, the poses that meet it faintly are measured, with a

@@ -18,6 +18,7 @@
 #pragma once
 
 #include <cstddef>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -25,6 +26,7 @@
 #include "antpose/core/check.hpp"
 #include "antpose/reconstruction/mast.hpp"
 #include "antpose/registration/pose_evidence.hpp"
+#include "antpose/registration/shape_fit.hpp"
 
 namespace antpose::registration {
 
@@ -34,6 +36,9 @@ struct PoseCandidate {
   std::string strategy;  // the strategy that proposed it (for reports)
   PoseEvidence evidence;
   double score = 1.0;  // evidence.score
+  /// The model's edge rounding profiled at this pose (shape_fit.hpp), where it was: a later
+  /// registration of the same antenna starts from that model and keeps the profile.
+  std::shared_ptr<const EdgeRadiusFit> edge_radius;
 };
 
 struct SelectionOptions {

@@ -87,14 +87,19 @@ std::vector<Refined> refine_all(const std::shared_ptr<const model::AntennaModel>
   descent.outline_box_m = model.size_m;
   auto polish = polish_of(descent);
   std::vector<Refined> out;
-  for (const auto& proposal : proposals)
+  for (const auto& proposal : proposals) {
+    // A proposal whose rounding was profiled is refined with that rounding's model.
+    const auto with = proposal.edge_radius ? std::make_shared<const model::AntennaModel>(proposal.edge_radius->model)
+                                           : shared;
     for (const SilhouetteOptions* options : {&descent, &polish}) {
       Refined& r = out.emplace_back();
-      r.outline = refine_by_silhouette(model.mesh_antenna, proposal.T_board_antenna, s.views, s.intrinsics, *options);
+      r.outline = refine_by_silhouette(with->mesh_antenna, proposal.T_board_antenna, s.views, s.intrinsics, *options);
       r.candidate = proposal;
       r.candidate.T_board_antenna = r.outline.T_board_antenna;
-      r.model = shared;
+      r.model = with;
+      if (proposal.edge_radius) r.radius = *proposal.edge_radius;
     }
+  }
   return out;
 }
 
@@ -121,13 +126,27 @@ std::vector<Refined> distinct_in_rectangle(std::vector<Refined> refined, const m
 
 // The best candidates' edge rounding profiled with their poses (shape_fit.hpp): each then carries
 // its best radius's pose, outline and model. Before any judgement of the outline: fitted with the
-// wrong rounding, even the right pose may fit its outline poorly.
+// wrong rounding, even the right pose may fit its outline poorly. A candidate whose rounding a
+// previous registration profiled within same_pose of where it now stands keeps that profile: the
+// rounding is the panel's, and its pose has not moved enough to change what the profile saw.
 void fit_shapes(std::vector<Refined>& kept, const AntennaScene& s, const RegisterOptions& o) {
   for (std::size_t i = 0; i < std::min(kept.size(), o.shape_candidates); ++i) {
     auto& k = kept[i];
+    if (k.radius) {
+      const Iso3& T = k.candidate.T_board_antenna;
+      const Iso3& U = k.radius->outline.T_board_antenna;
+      if (rad2deg(rotation_distance(T.linear(), U.linear())) < o.same_pose_deg &&
+          (T.translation() - U.translation()).norm() < o.same_pose_m) {
+        k.radius->outline = k.outline;
+        continue;
+      }
+    }
     auto fit = fit_edge_radius(*k.model, k.candidate.T_board_antenna, s.views, s.intrinsics, polish_of(o.refine),
                                o.evidence, o.edge_radius);
-    if (!fit.fitted || fit.outline.score >= k.outline.score) continue;
+    if (!fit.fitted || fit.outline.score >= k.outline.score) {
+      if (k.radius) k.radius->outline = k.outline;
+      continue;
+    }
     k.outline = fit.outline;
     k.candidate.T_board_antenna = fit.outline.T_board_antenna;
     k.model = std::make_shared<const model::AntennaModel>(fit.model);
@@ -186,6 +205,7 @@ AntennaRegistration select(const AntennaScene& s, std::vector<Refined> kept, con
   for (auto& k : kept) {
     const EvidenceJudge judge(*k.model, scene, o.evidence);
     candidates.push_back(k.candidate);
+    candidates.back().edge_radius = k.radius ? std::make_shared<const EdgeRadiusFit>(*k.radius) : nullptr;
     candidates.back().evidence = judge(k.candidate.T_board_antenna);
     candidates.back().score = candidates.back().evidence.score(judge.options());
     twins.push_back(judge(turned_round(k.candidate.T_board_antenna)));
