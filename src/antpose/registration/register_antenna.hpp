@@ -113,7 +113,8 @@ std::vector<PoseCandidate> propose_poses(const model::AntennaModel& model, const
                                          const RegisterOptions& options, bool outline_only = false);
 
 /// The proposals refined, judged and selected. A second registration of the same antenna in a
-/// scene that knows more (a mast, neighbours) passes the first one's candidates as proposals.
+/// scene that knows more (a mast, neighbours) passes the first one's candidates as proposals;
+/// those with a profiled edge rounding keep it (PoseCandidate::edge_radius).
 AntennaRegistration register_antenna(const model::AntennaModel& model, const AntennaScene& scene,
                                      const RegisterOptions& options, const std::vector<PoseCandidate>& proposals);
 
