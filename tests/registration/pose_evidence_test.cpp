@@ -54,23 +54,6 @@ TEST(PoseEvidence, UnitsEitherPoseLacksDoNotEnter) {
   EXPECT_FALSE(c.decisive) << "one unit alone cannot be decisive";
 }
 
-TEST(PoseEvidence, PlausibilityFallsWithTheDifferenceInStandardErrors) {
-  Comparison c;
-  c.standard_error = 0.02;
-  c.difference = 0.0;
-  EXPECT_DOUBLE_EQ(plausibility(c), 1.0) << "a tie";
-  c.difference = 0.02;
-  EXPECT_NEAR(plausibility(c), 0.3173, 1e-4) << "one standard error";
-  c.difference = 0.05;
-  EXPECT_NEAR(plausibility(c), 0.0124, 1e-4) << "2.5 standard errors";
-  c.difference = -0.02;
-  EXPECT_NEAR(plausibility(c), 1.6827, 1e-4) << "the other fits better";
-  c.standard_error = 0.0;
-  EXPECT_EQ(plausibility(c), 1.0);
-  c.difference = 0.01;
-  EXPECT_EQ(plausibility(c), 0.0) << "every unit agrees the other is worse";
-}
-
 // The fixture's panel with points on what the cameras see of it, 5 mm noise.
 PointCloud seen_points(const SyntheticScene& s) {
   const auto model = model::parametric_panel({});

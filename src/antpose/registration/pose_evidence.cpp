@@ -114,11 +114,6 @@ Comparison compare_side(const PoseEvidence& better, const PoseEvidence& other, c
                  o);
 }
 
-double plausibility(const Comparison& c) {
-  if (c.standard_error > 0.0) return std::erfc(c.difference / c.standard_error / std::sqrt(2.0));
-  return c.difference > 0.0 ? 0.0 : 1.0;
-}
-
 EvidenceJudge::EvidenceJudge(const model::AntennaModel& model, const EvidenceScene& scene,
                              const EvidenceOptions& options)
     : model_(model),

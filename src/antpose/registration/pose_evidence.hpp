@@ -93,12 +93,6 @@ Comparison compare_shape(const PoseEvidence& better, const PoseEvidence& other, 
 Comparison compare_placement(const PoseEvidence& better, const PoseEvidence& other, const EvidenceOptions& options);
 Comparison compare_side(const PoseEvidence& better, const PoseEvidence& other, const EvidenceOptions& options);
 
-/// How plausibly `other` fits as well as `better`, as a weight: 2Φ(−D/SE), twice the chance under
-/// the comparison's normal approximation that the score difference D is in fact ≤ 0 — 1 for a
-/// tie, 0.32 at one standard error, 0.01 at 2.6, above 1 where `other` scores lower; 0 or 1 where
-/// the units agree exactly (SE = 0), as D > 0 or not.
-double plausibility(const Comparison& comparison);
-
 /// The scene a model's poses are judged in: the photos (with known objects as occluders and
 /// background edges), the region's points and where the cameras were (board frame).
 struct EvidenceScene {

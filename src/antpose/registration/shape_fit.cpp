@@ -73,25 +73,21 @@ EdgeRadiusFit fit_edge_radius(const model::AntennaModel& model, const Iso3& T_bo
   fit.radius_m = fit.radii_m[best];
   fit.model = models[best];
   fit.outline = results[best];
-  // The radii the photos do not rule out, and the spread of their poses about the best's, each
-  // weighted by how plausibly it fits as well as the best (pose_evidence.hpp; 1 for the best).
+  // The radii the photos do not rule out, and the spread of their poses about the best's.
   const PoseEvidence at_best = outline_evidence(models[best], results[best].T_board_antenna, views, K, refine);
   const Mat3& R_best = results[best].T_board_antenna.linear();
-  double weights = 0.0;
+  std::size_t n = 0;
   for (std::size_t k = 0; k < results.size(); ++k) {
-    double weight = 1.0;
     if (k != best) {
       const auto other = outline_evidence(models[k], results[k].T_board_antenna, views, K, refine);
-      const Comparison c = compare_shape(at_best, other, evidence);
-      if (c.decisive) continue;
-      weight = plausibility(c);
+      if (compare_shape(at_best, other, evidence).decisive) continue;
     }
     fit.within_m.push_back(fit.radii_m[k]);
     const Vec3 d = log_so3(results[k].T_board_antenna.linear() * R_best.transpose());
-    fit.spread_board += weight * d * d.transpose();
-    weights += weight;
+    fit.spread_board += d * d.transpose();
+    ++n;
   }
-  fit.spread_board /= weights;
+  fit.spread_board /= static_cast<double>(n);
   return fit;
 }
 

@@ -6,9 +6,8 @@
 // radius fitted as 20 mm: 3–6°). So the edge radius is profiled: the pose refined by its outline
 // at full resolution (silhouette.hpp) with the panel's model at each radius of a grid from sharp to
 // half its depth, the best-fitting radius kept, and the poses of every radius the photos do not
-// rule out (pose_evidence.hpp's paired test) added to the covariance, each weighted by how
-// plausibly it fits as well as the best — the radius is a nuisance parameter whose uncertainty
-// the attitude must carry (a profile likelihood).
+// rule out (pose_evidence.hpp's paired test) added to the covariance — the radius is a nuisance
+// parameter whose uncertainty the attitude must carry (a profile likelihood).
 #pragma once
 
 #include <cstddef>
@@ -35,7 +34,7 @@ struct EdgeRadiusFit {
   SilhouetteResult outline;             // its refinement
   std::vector<double> radii_m, scores;  // the profile
   std::vector<double> within_m;         // the radii the photos do not rule out
-  Mat3 spread_board = Mat3::Zero();     // rad², the rotations of those radii about the best's, weighted
+  Mat3 spread_board = Mat3::Zero();     // rad², the rotations of those radii about the best's
 };
 
 /// Profiles the edge radius of `model` (a parametric panel; else nothing fitted) at the box pose
