@@ -150,6 +150,28 @@ TEST_F(MeasureCli, PhotosAllFromOnePlaceGiveNoConfidentNumber) {
   EXPECT_THAT(j["antennas"][0]["error"].get<std::string>(), HasSubstr("walking a few metres round it"));
 }
 
+TEST_F(MeasureCli, PhotosOverANarrowArcAreWarnedOf) {
+  const auto cap = copy("narrow-arc");
+  // The ROI's photo and the next one: the antenna seen over about 7°.
+  std::string shots = "index,t,image\n";
+  const auto lines = io::read_text(capture() / "shots.csv");
+  auto at = lines.rfind('\n', lines.find(roi_image_)) + 1;
+  for (int i = 0; i < 2; ++i) {
+    const auto end = lines.find('\n', at);
+    shots += fmt::format("{},{}\n", i, lines.substr(lines.find(',', at) + 1, end - lines.find(',', at) - 1));
+    at = end + 1;
+  }
+  test::write_file(cap / "shots.csv", shots);
+  const auto json = *dir_ / "narrow-arc.json";
+  const auto r =
+      test::run_cli(measure(cap, fmt::format("--model {} --roi {} --json '{}'", model_, roi_, json.string())));
+  const auto j = nlohmann::json::parse(io::read_text(json));
+  const auto warnings = j["antennas"][0]["warnings"].dump();
+  EXPECT_THAT(warnings, HasSubstr("the photos see the antenna over only 6."));
+  EXPECT_THAT(warnings, HasSubstr("(less than 10°): its attitude rests on nearly one outline"));
+  EXPECT_THAT(warnings, HasSubstr("photograph it over a wider arc")) << r.err;
+}
+
 TEST_F(MeasureCli, ModelInMillimetresAndOtherBadArgumentsAreNamed) {
   // The built-in panel written in millimetres.
   const auto panel = model::builtin_panel(model_);

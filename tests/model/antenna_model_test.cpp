@@ -105,9 +105,42 @@ TEST(Panel, InvalidSpecsAreRefused) {
               HasSubstr("bracket height 0.3 m: must be below 0.262 m"));
   EXPECT_THAT(refusal([](PanelSpec& s) { s.bracket_end_fraction = 0.5; }), HasSubstr("bracket end fraction 0.5"));
   EXPECT_THAT(refusal([](PanelSpec& s) { s.bracket_depth_m = 0; }), HasSubstr("panel bracket size"));
+  EXPECT_THAT(refusal([](PanelSpec& s) { s.end_cap_height_m = 0.7; }),
+              HasSubstr("panel end caps 0.7 m long with a rim of 0 m: the length must be ≥ 0 and below half the "
+                        "height (0.655 m)"));
+  EXPECT_THAT(refusal([](PanelSpec& s) { s.end_cap_height_m = 0.04, s.end_cap_rim_m = -0.001; }),
+              HasSubstr("a rim of -0.001 m"));
   PanelSpec no_bracket;
   no_bracket.bracket = false, no_bracket.bracket_width_m = 5;  // ignored without brackets
   EXPECT_NO_THROW(parametric_panel(no_bracket));
+}
+
+// End caps 4 cm long standing 8 mm out of the radome: closed meshes of their own at each end, in
+// the panel's mesh, outside its box across but not along; flush caps change nothing.
+TEST(Panel, EndCapsStandOutOfTheRadome) {
+  PanelSpec s;
+  s.end_cap_height_m = 0.04, s.end_cap_rim_m = 0.008;
+  const auto caps = end_cap_meshes(s);
+  ASSERT_EQ(caps.size(), 2u);
+  for (const auto& cap : caps) EXPECT_TRUE(is_closed(cap));
+  const auto [lo, hi] = bounding_box(caps[1]);
+  EXPECT_NEAR(hi.z(), s.height_m / 2, 1e-12);
+  EXPECT_NEAR(lo.z(), s.height_m / 2 - 0.04, 1e-12);
+  EXPECT_NEAR(hi.x(), s.width_m / 2 + 0.008, 1e-12);
+  EXPECT_NEAR(lo.y(), -s.depth_m / 2 - 0.008, 1e-12);
+
+  const auto capped = parametric_panel(s);
+  EXPECT_EQ(capped.size_m, Vec3(s.width_m, s.depth_m, s.height_m)) << "the box is the radome's";
+  EXPECT_TRUE(outline_box(capped).isApprox(capped.size_m + Vec3(0.016, 0.016, 0.0)));
+  const auto plain = parametric_panel(PanelSpec{});
+  EXPECT_EQ(capped.mesh_antenna.triangles.size(),
+            plain.mesh_antenna.triangles.size() + caps[0].triangles.size() + caps[1].triangles.size());
+  EXPECT_NEAR(bounding_box(capped.mesh_antenna).second.x(), s.width_m / 2 + 0.008, 1e-12);
+
+  s.end_cap_rim_m = 0;
+  EXPECT_EQ(parametric_panel(s).mesh_antenna.triangles.size(), plain.mesh_antenna.triangles.size());
+  EXPECT_EQ(outline_box(parametric_panel(s)), plain.size_m);
+  EXPECT_TRUE(end_cap_meshes(PanelSpec{}).empty());
 }
 
 TEST(Panel, BuiltinsByName) {

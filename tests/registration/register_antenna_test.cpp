@@ -99,16 +99,16 @@ TEST(RegisterAntenna, ASecondRegistrationKeepsTheProfiledRounding) {
   AntennaScene scene = antenna_scene(s);
   const auto first = register_antenna(model::parametric_panel({}), scene, {});
   ASSERT_TRUE(first.found) << first.why_not;
-  ASSERT_TRUE(first.edge_radius && first.edge_radius->fitted);
+  ASSERT_TRUE(first.panel_shape && first.panel_shape->fitted);
   const auto profiled = std::count_if(first.candidates.begin(), first.candidates.end(),
-                                      [](const PoseCandidate& c) { return c.edge_radius != nullptr; });
+                                      [](const PoseCandidate& c) { return c.panel_shape != nullptr; });
   EXPECT_GE(profiled, 1);
   scene.mast = s.mast;
   const auto second = register_antenna(model::parametric_panel({}), scene, {}, first.candidates);
   ASSERT_TRUE(second.found) << second.why_not;
-  ASSERT_TRUE(second.edge_radius);
-  EXPECT_EQ(second.edge_radius->radius_m, first.edge_radius->radius_m);
-  EXPECT_EQ(second.edge_radius->scores, first.edge_radius->scores) << "the profile is the first's";
+  ASSERT_TRUE(second.panel_shape);
+  EXPECT_EQ(second.panel_shape->radius_m, first.panel_shape->radius_m);
+  EXPECT_EQ(second.panel_shape->scores, first.panel_shape->scores) << "the profile is the first's";
   EXPECT_LT(rad2deg(rotation_distance(second.T_board_antenna.linear(), s.T_board_antenna.linear())), 1.0);
   EXPECT_NEAR(second.rotation_covariance_board.trace(), first.rotation_covariance_board.trace(),
               0.5 * first.rotation_covariance_board.trace());

@@ -23,7 +23,7 @@ SilhouetteOptions polish() {
 
 // A panel whose vertical edges are rounder (45 mm) than its datasheet model's (20 mm), seen over
 // 30° from 15° off its front: fitted with the model's rounding the yaw makes up for it.
-TEST(EdgeRadius, TheRadomesRoundingIsFittedAndTheYawWithIt) {
+TEST(ShapeFit, TheRadomesRoundingIsFittedAndTheYawWithIt) {
   SceneSpec spec;
   spec.panel.edge_radius_m = 0.045;
   spec.view_offsets_deg = {0.0, 5.0, 10.0, 15.0, 20.0, 25.0, 30.0};
@@ -33,7 +33,7 @@ TEST(EdgeRadius, TheRadomesRoundingIsFittedAndTheYawWithIt) {
   auto o = polish();
   o.outline_box_m = model.size_m;
   const auto as_modelled = refine_by_silhouette(model.mesh_antenna, s.T_board_antenna, s.views, s.intrinsics, o);
-  const auto fit = fit_edge_radius(model, s.T_board_antenna, s.views, s.intrinsics, polish(), {}, {});
+  const auto fit = fit_shape(model, s.T_board_antenna, s.views, s.intrinsics, polish(), {}, {});
   ASSERT_TRUE(fit.fitted);
   EXPECT_NEAR(fit.radius_m, 0.045, 0.006);
   EXPECT_LT(fit.outline.score, as_modelled.score);
@@ -44,19 +44,52 @@ TEST(EdgeRadius, TheRadomesRoundingIsFittedAndTheYawWithIt) {
   EXPECT_LT(error, 1.0);
   EXPECT_LT(3 * error, modelled_error);
   // The radii the photos do not rule out include the best, and their spread is the σ's share.
-  EXPECT_NE(std::find(fit.within_m.begin(), fit.within_m.end(), fit.radius_m), fit.within_m.end());
+  ASSERT_FALSE(fit.within.empty());
+  EXPECT_TRUE(std::any_of(fit.within.begin(), fit.within.end(),
+                          [&](std::size_t k) { return fit.radii_m[k] == fit.radius_m && fit.rims_m[k] == fit.rim_m; }));
   EXPECT_GE(fit.spread_board.trace(), 0.0);
 }
 
-TEST(EdgeRadius, AMeshFromAFileKeepsItsShape) {
+// A short panel with end caps standing 8 mm out of its radome, seen from well below over a
+// narrow arc: its downtilt is read from where its ends lie, which the caps move. Fitted without
+// caps the downtilt makes up for them; with the caps' rim profiled it does not.
+TEST(ShapeFit, TheEndCapsRimIsFittedAndTheDowntiltWithIt) {
+  SceneSpec spec;
+  spec.panel.height_m = 0.7, spec.panel.width_m = 0.4, spec.panel.depth_m = 0.18;
+  spec.panel.end_cap_height_m = 0.04, spec.panel.end_cap_rim_m = 0.008;
+  spec.antenna_height_m = 5.0, spec.distance_m = 4.0, spec.below_m = 3.5, spec.focal_px = 1400;
+  spec.view_offsets_deg = {-6.0, -3.0, 0.0, 3.0, 6.0};
+  const auto s = make_scene(spec);
+  auto datasheet = spec.panel;
+  datasheet.end_cap_height_m = datasheet.end_cap_rim_m = 0;
+  const auto model = model::parametric_panel(datasheet);
+  ShapeOptions no_caps;
+  no_caps.rim_steps = 0;
+  const auto without = fit_shape(model, s.T_board_antenna, s.views, s.intrinsics, polish(), {}, no_caps);
+  const auto fit = fit_shape(model, s.T_board_antenna, s.views, s.intrinsics, polish(), {}, {});
+  ASSERT_TRUE(fit.fitted && without.fitted);
+  EXPECT_NEAR(fit.rim_m, 0.008, 0.003);
+  EXPECT_LT(fit.outline.score, without.outline.score);
+  const auto error = [&](const ShapeFit& f) {
+    return rad2deg(rotation_distance(f.outline.T_board_antenna.linear(), s.T_board_antenna.linear()));
+  };
+  std::printf("rim %.4f m, radius %.4f m, error %.2f°; without caps %.2f° (radius %.4f m)\n", fit.rim_m, fit.radius_m, error(fit), error(without), without.radius_m);
+  EXPECT_LT(error(fit), 0.3);
+  EXPECT_LT(2 * error(fit), error(without));
+}
+
+TEST(ShapeFit, AMeshFromAFileKeepsItsShape) {
   const auto s = make_scene();
   auto model = model::parametric_panel({});
   model.panel.reset();  // as a scanned mesh: its shape is measured, not a guess
-  EXPECT_FALSE(fit_edge_radius(model, s.T_board_antenna, s.views, s.intrinsics, polish(), {}, {}).fitted);
-  EdgeRadiusOptions off;
+  EXPECT_FALSE(fit_shape(model, s.T_board_antenna, s.views, s.intrinsics, polish(), {}, {}).fitted);
+  ShapeOptions off;
   off.enabled = false;
+  ShapeOptions bad;
+  bad.rim_steps = 1;
+  EXPECT_THROW(fit_shape(model, s.T_board_antenna, s.views, s.intrinsics, polish(), {}, bad), std::invalid_argument);
   EXPECT_FALSE(
-      fit_edge_radius(model::parametric_panel({}), s.T_board_antenna, s.views, s.intrinsics, polish(), {}, off).fitted);
+      fit_shape(model::parametric_panel({}), s.T_board_antenna, s.views, s.intrinsics, polish(), {}, off).fitted);
 }
 
 }  // namespace

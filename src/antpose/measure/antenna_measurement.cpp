@@ -129,8 +129,11 @@ void apply_registration(AntennaMeasurement& m, const model::AntennaModel& model,
   m.registration_candidates = r.candidates;
   m.method = fmt::format("model {}, outline in {} photos + points", model.name, r.outline_views);
   m.warnings.insert(m.warnings.end(), r.warnings.begin(), r.warnings.end());
-  const model::AntennaModel& fitted = r.edge_radius ? r.edge_radius->model : model;
-  if (r.edge_radius) m.edge_radius_m = r.edge_radius->radius_m, m.edge_radii_within_m = r.edge_radius->within_m;
+  const model::AntennaModel& fitted = r.panel_shape ? r.panel_shape->model : model;
+  if (const auto& f = r.panel_shape) {
+    m.edge_radius_m = f->radius_m, m.end_cap_rim_m = f->rim_m;
+    for (const std::size_t k : f->within) m.shapes_within_m.push_back({f->radii_m[k], f->rims_m[k]});
+  }
   m.model_board = transformed(model::sample_surface(fitted.mesh_antenna, 0.01, 1), r.T_board_antenna);
   std::tie(m.fitness, m.fit_rmse_m) = points_fit(m.region.cloud_board, m.model_board, o.reach_m);
   if (m.fit_rmse_m > o.warn_rmse_m)
@@ -141,6 +144,16 @@ void apply_registration(AntennaMeasurement& m, const model::AntennaModel& model,
         "only {:.0f} % of the region's points lie near the registered model: the region holds other objects (mast, "
         "arms, other panels) or its points are sparse (a plain radome)",
         100 * m.fitness));
+  // Without texture the angles rest on the outline, and the downtilt on where the panel's ends lie
+  // along the lines of sight. An end face as dark or as bright as what lies behind it leaves the
+  // end's outline without an edge, and a pose that lays it on the crease with the next face
+  // instead meets an edge in every photo: no photo of that arc tells the two apart.
+  if (m.region.region_coverage < o.region.min_coverage)
+    m.warnings.push_back(
+        "the radome shows little texture, so the angles rest on its outline and the downtilt on where the panel's "
+        "ends lie in the photos: an end face as dark or as bright as what lies behind it can move the downtilt by "
+        "more than its σ (check the ends in the report's overlays); photos from the antenna's side, where its long "
+        "edges show the downtilt, settle it");
   if (rad2deg(r.dilation_yaw_sigma_rad) > o.warn_dilation_yaw_sigma_deg)
     m.warnings.push_back(fmt::format(
         "the outline's width barely changes with yaw in these photos: a blur of a fraction of a pixel turns the yaw "
@@ -193,6 +206,8 @@ OptionProblems AntennaOptions::Check() const {
   p.require(mast_clearance_m >= 0 && mast_outline_below_m > 0, "mast_clearance_m, mast_outline_below_m",
             "clearance ≥ 0, stretch > 0");
   p.require(reach_m > 0, "reach_m", "positive");
+  p.require(min_viewing_span_deg >= 0 && warn_viewing_span_deg >= min_viewing_span_deg,
+            "min_viewing_span_deg, warn_viewing_span_deg", "0 ≤ refusal ≤ warning");
   p.require(region.min_points >= 1, "region.min_points", "at least 1");
   return p;
 }
@@ -233,14 +248,23 @@ void measure_antenna(AntennaMeasurement& m, const model::AntennaModel* model, co
   throw_unless_ok(o.Check(), "AntennaOptions");
   // From one place the photos see the antenna along one line of sight: neither its points nor
   // its outline fix its depth or its turn.
-  if (const double span = viewing_span(c.poses->views, rough_centre(m, model, c));
-      span < deg2rad(o.min_viewing_span_deg)) {
+  // Over a narrow arc they see it along nearly one line of sight: its points have little depth,
+  // and its attitude rests on the sub-pixel detail of one outline, where whatever the model lacks
+  // (end caps, mounts, shading) turns it.
+  const double span = viewing_span(c.poses->views, rough_centre(m, model, c));
+  if (span < deg2rad(o.min_viewing_span_deg)) {
     m.error = fmt::format(
         "the photos see the antenna from nearly one place (their lines of sight to it span {:.1f}°, "
         "at least {:.0f}° needed): take the photos while walking a few metres round it",
         rad2deg(span), o.min_viewing_span_deg);
     return;
   }
+  if (span < deg2rad(o.warn_viewing_span_deg))
+    m.warnings.push_back(fmt::format(
+        "the photos see the antenna over only {:.1f}° (less than {:.0f}°): its attitude rests on nearly one "
+        "outline and its points have little depth, so the angles may be off by more than their σ; photograph it "
+        "over a wider arc (walking sideways a third of the distance to it gives about 20°)",
+        rad2deg(span), o.warn_viewing_span_deg));
   if (!model) {
     measure_model_free(m, c, o);
   } else {

@@ -10,6 +10,7 @@
 // reconstruction), plus the board's attitude in the world (antenna_attitude.hpp).
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <optional>
 #include <string>
@@ -53,6 +54,7 @@ struct AntennaOptions {
   reconstruction::MastOptions mast_options;
   reconstruction::MastSearchOptions mast_search;  // by its outline, where the points give no mast
   double min_viewing_span_deg = 2.0;              // of the photos' lines of sight to the antenna
+  double warn_viewing_span_deg = 10.0;            // below: a warning that the angles rest on one outline
   double reach_m = 0.03;                          // a point this near the registered model is explained by it
   double warn_rmse_m = 0.015;                     // their RMS distance above this: a poor fit
   double warn_fitness = 0.5;                      // a share of the region's points explained below this: a warning
@@ -78,7 +80,8 @@ struct AntennaMeasurement {
   double fitness = 0.0;                      // share of region points within reach of the model
   std::optional<double> silhouette_rms_px;   // the outline's edge RMS
   std::optional<double> edge_radius_m;       // the radome's edge rounding fitted (a parametric panel)
-  std::vector<double> edge_radii_within_m;   // the radii the photos do not rule out
+  std::optional<double> end_cap_rim_m;       // how far its end caps stand out of the radome (fitted)
+  std::vector<std::array<double, 2>> shapes_within_m;  // (radius, rim) the photos do not rule out
   std::optional<reconstruction::Mast> mast;  // the mast found beside it, if any
   std::size_t candidates = 0;                // poses proposed by the strategies
   std::vector<registration::PoseCandidate> registration_candidates;  // refined and distinct (board frame)

@@ -102,7 +102,8 @@ nlohmann::json antenna_json(const AntennaMeasurement& m) {
                        {"front_back", comparison_json(m.front_back)},
                        {"front_back_cue", registration::to_string(m.front_back_cue)},
                        {"edge_radius_m", m.edge_radius_m ? nlohmann::json(*m.edge_radius_m) : nullptr},
-                       {"edge_radii_within_m", m.edge_radii_within_m}};
+                       {"end_cap_rim_m", m.end_cap_rim_m ? nlohmann::json(*m.end_cap_rim_m) : nullptr},
+                       {"shapes_within_m", m.shapes_within_m}};
   if (m.mast)
     a["mast"] = {{"axis_point_board_m",
                   {m.mast->axis_point_board.x(), m.mast->axis_point_board.y(), m.mast->axis_point_board.z()}},

@@ -96,6 +96,12 @@ void validate(const PanelSpec& s) {
                     s.edge_radius_m, half));
   if (s.arc_segments < 1 || s.arc_segments > 64)
     throw std::invalid_argument(fmt::format("panel arc_segments = {}: must be 1..64", s.arc_segments));
+  if (!(s.end_cap_height_m >= 0 && s.end_cap_height_m < s.height_m / 2 && s.end_cap_rim_m >= 0 &&
+        s.end_cap_rim_m <= 0.05))
+    throw std::invalid_argument(fmt::format(
+        "panel end caps {} m long with a rim of {} m: the length must be ≥ 0 and below half the height ({} m), "
+        "the rim 0 .. 0.05 m",
+        s.end_cap_height_m, s.end_cap_rim_m, s.height_m / 2));
   if (!s.bracket) return;
   if (!positive(s.bracket_width_m) || !positive(s.bracket_depth_m) || !positive(s.bracket_height_m))
     throw std::invalid_argument("panel bracket size: width, depth and height must be > 0");
@@ -308,12 +314,36 @@ AntennaModel load_antenna_model(const fs::path& mesh_file, const std::optional<f
   return model;
 }
 
+std::vector<Mesh> end_cap_meshes(const PanelSpec& spec) {
+  validate(spec);
+  if (spec.end_cap_height_m <= 0.0) return {};
+  PanelSpec cap;
+  const double rim = spec.end_cap_rim_m;
+  cap.width_m = spec.width_m + 2 * rim, cap.depth_m = spec.depth_m + 2 * rim, cap.height_m = spec.end_cap_height_m;
+  cap.edge_radius_m = spec.edge_radius_m + rim;
+  cap.arc_segments = spec.arc_segments;
+  cap.bracket = false;
+  const Mesh mesh = panel_mesh(cap);
+  std::vector<Mesh> caps;
+  for (const double side : {-1.0, 1.0})
+    caps.push_back(transformed(mesh, Iso3(Eigen::Translation3d(0.0, 0.0, side * (spec.height_m - cap.height_m) / 2))));
+  return caps;
+}
+
+Vec3 outline_box(const AntennaModel& model) {
+  const double rim = model.panel && model.panel->end_cap_height_m > 0 ? model.panel->end_cap_rim_m : 0.0;
+  return model.size_m + Vec3(2 * rim, 2 * rim, 0.0);
+}
+
 AntennaModel parametric_panel(const PanelSpec& spec) {
   validate(spec);
   AntennaModel model;
   model.name =
       fmt::format("parametric-{:.0f}x{:.0f}x{:.0f}", spec.height_m * 1e3, spec.width_m * 1e3, spec.depth_m * 1e3);
   model.mesh_antenna = panel_mesh(spec);
+  // Caps flush with the radome change nothing of its shape.
+  if (spec.end_cap_rim_m > 0)
+    for (const Mesh& cap : end_cap_meshes(spec)) append_mesh(model.mesh_antenna, cap);
   model.size_m = Vec3(spec.width_m, spec.depth_m, spec.height_m);
   model.panel = std::make_shared<const PanelSpec>(spec);
   return model;

@@ -61,6 +61,10 @@ struct PanelSpec {
   /// the height).
   double bracket_end_fraction = 0.25;
   int arc_segments = 6;  // flat facets per rounded edge
+  /// End caps: mouldings at both ends, end_cap_height_m long and flush with them, standing out of
+  /// the radome's section all round by end_cap_rim_m (their corners rounded by the edge radius plus
+  /// the rim). Height 0: none. A datasheet box leaves them out: it gives the radome's section.
+  double end_cap_height_m = 0.0, end_cap_rim_m = 0.0;
 };
 
 /// The closed, outward-wound triangle mesh of a panel in the antenna frame: box centre at the
@@ -74,6 +78,15 @@ struct PanelSpec {
 /// the back plate, whose end fraction is not in (0, 1/2), or that does not fit between its end
 /// and the other bracket (for brackets at 1/4 and 3/4: not shorter than height/2).
 AntennaModel parametric_panel(const PanelSpec& spec);
+
+/// The end caps of PanelSpec (two closed meshes, bottom then top; none for height 0), as
+/// parametric_panel adds them to the panel's mesh where they stand out of its section.
+std::vector<Mesh> end_cap_meshes(const PanelSpec& spec);
+
+/// The box the model's own outline stays within (antenna frame, centred): its box, grown across
+/// by the end caps' rim. Outside it lie attachments (brackets), whose outline misleads
+/// (registration/silhouette.hpp, SilhouetteOptions::outline_box_m).
+Vec3 outline_box(const AntennaModel& model);
 
 /// Built-in panels by name: "thesis-1310x159x80" (the thesis's scanned panel) and any datasheet
 /// box "panel-<h>x<w>x<d>", height × width × depth in whole millimetres (h 300..4000, w 100..800,

@@ -103,6 +103,8 @@ struct RegionOptions {
   /// Where no object gives min_points, the nearest object's few points are returned with a
   /// warning instead of an error: a model's outline may still place the antenna.
   bool allow_few_points = false;
+  /// Below this region_coverage the object shows little texture (a warning).
+  double min_coverage = 0.6;
 };
 
 struct RegionReconstruction {
@@ -114,7 +116,8 @@ struct RegionReconstruction {
   double depth_near_m = 0.0, depth_far_m = 0.0;
   /// Fraction of the object's outline in views[roi_view] (cells of ≥ 8 px and ≥ 1.5 voxels inside the convex hull
   /// of the points' projections) that holds points: ~0.9 on a textured or weathered radome, low
-  /// on a plain one (only edges and details carry texture; < 0.6 adds a warning).
+  /// on a plain one (only edges and details carry texture; below RegionOptions::min_coverage a
+  /// warning).
   double region_coverage = 0.0;
   std::vector<std::string> warnings;
 };

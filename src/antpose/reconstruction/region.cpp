@@ -707,7 +707,7 @@ ObjectAttempt reconstruct_object(const std::vector<PosedView>& views, const Refi
     }
     const double inside_hull = std::max(1.0, double(cv::countNonZero(hull_mask)));
     out.region_coverage = double(cv::countNonZero(occupied & hull_mask)) / inside_hull;
-    if (out.region_coverage < 0.6)
+    if (out.region_coverage < options.min_coverage)
       out.warnings.push_back(
           fmt::format("the points cover only {:.0f}% of the object's outline in {}: little texture (a plain radome?) — "
                       "the points lie on "

@@ -123,7 +123,7 @@ EvidenceJudge::EvidenceJudge(const model::AntennaModel& model, const EvidenceSce
   throw_unless_ok(options.Check(), "EvidenceOptions");
   if (!scene.views || scene.views->empty() || !scene.points_board)
     throw std::invalid_argument("EvidenceJudge: a scene without photos or points");
-  options_.outline.outline_box_m = model.size_m;
+  options_.outline.outline_box_m = model::outline_box(model);
   const Vec3 up = scene.up_board.normalized();
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
   for (const Vec3& p : scene.points_board->points) lo = std::min(lo, p.dot(up)), hi = std::max(hi, p.dot(up));

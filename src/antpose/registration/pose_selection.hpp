@@ -36,9 +36,9 @@ struct PoseCandidate {
   std::string strategy;  // the strategy that proposed it (for reports)
   PoseEvidence evidence;
   double score = 1.0;  // evidence.score
-  /// The model's edge rounding profiled at this pose (shape_fit.hpp), where it was: a later
+  /// The panel's shape profiled at this pose (shape_fit.hpp), where it was: a later
   /// registration of the same antenna starts from that model and keeps the profile.
-  std::shared_ptr<const EdgeRadiusFit> edge_radius;
+  std::shared_ptr<const ShapeFit> panel_shape;
 };
 
 struct SelectionOptions {

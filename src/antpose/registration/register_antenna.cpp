@@ -17,8 +17,8 @@ namespace {
 struct Refined {
   PoseCandidate candidate;
   SilhouetteResult outline;
-  std::shared_ptr<const model::AntennaModel> model;  // refined with: the edge radius fitted, where it was
-  std::optional<EdgeRadiusFit> radius;
+  std::shared_ptr<const model::AntennaModel> model;  // refined with: the panel's shape fitted, where it was
+  std::optional<ShapeFit> panel_shape;
 };
 
 // Where the outline search starts the box's centre besides the rectangle's own fit: the region's
@@ -43,7 +43,7 @@ std::vector<PoseCandidate> from_outline(const model::AntennaModel& model, const 
   std::vector<PoseCandidate> out;
   for (const auto& c : search_box_outline(in, s.intrinsics, o.search).candidates) {
     if (out.size() >= o.refine_candidates) break;
-    out.push_back({c.T_board_antenna, "outline search", {}, c.cost});
+    out.push_back({c.T_board_antenna, "outline search", {}, c.cost, nullptr});
   }
   return out;
 }
@@ -56,14 +56,14 @@ std::vector<PoseCandidate> from_points(const model::AntennaModel& model, const A
   const auto model_cloud = prepare(model::sample_surface(model.mesh_antenna, o.evidence.model_spacing_m, 1), g.fine);
   const auto cloud = prepare(s.points_board, g.fine);
   const auto start = global_align(cloud, model_cloud, s.up_board, g);
-  std::vector<PoseCandidate> out{{start.fit.T_target_source.inverse(), "points' global start", {}, 0.0}};
+  std::vector<PoseCandidate> out{{start.fit.T_target_source.inverse(), "points' global start", {}, 0.0, nullptr}};
   for (const auto& h : start.hypotheses) {
     if (out.size() >= o.refine_candidates) break;
     const Iso3 T = h.T_model_scene.inverse();
     const bool apart = std::all_of(out.begin(), out.end(), [&](const PoseCandidate& c) {
       return boresight_angle(c.T_board_antenna.linear(), T.linear()) > deg2rad(o.selection.rival_min_deg);
     });
-    if (apart) out.push_back({T, "points' global start", {}, h.score()});
+    if (apart) out.push_back({T, "points' global start", {}, h.score(), nullptr});
   }
   return out;
 }
@@ -82,22 +82,21 @@ SilhouetteOptions polish_of(const SilhouetteOptions& descent) {
 // blur its edges into its neighbours'.
 std::vector<Refined> refine_all(const std::shared_ptr<const model::AntennaModel>& shared, const AntennaScene& s,
                                 const std::vector<PoseCandidate>& proposals, const RegisterOptions& o) {
-  const model::AntennaModel& model = *shared;
-  auto descent = o.refine;
-  descent.outline_box_m = model.size_m;
-  auto polish = polish_of(descent);
   std::vector<Refined> out;
   for (const auto& proposal : proposals) {
-    // A proposal whose rounding was profiled is refined with that rounding's model.
-    const auto with = proposal.edge_radius ? std::make_shared<const model::AntennaModel>(proposal.edge_radius->model)
+    // A proposal whose shape was profiled is refined with that shape's model.
+    const auto with = proposal.panel_shape ? std::make_shared<const model::AntennaModel>(proposal.panel_shape->model)
                                            : shared;
+    auto descent = o.refine;
+    descent.outline_box_m = model::outline_box(*with);
+    auto polish = polish_of(descent);
     for (const SilhouetteOptions* options : {&descent, &polish}) {
       Refined& r = out.emplace_back();
       r.outline = refine_by_silhouette(with->mesh_antenna, proposal.T_board_antenna, s.views, s.intrinsics, *options);
       r.candidate = proposal;
       r.candidate.T_board_antenna = r.outline.T_board_antenna;
       r.model = with;
-      if (proposal.edge_radius) r.radius = *proposal.edge_radius;
+      if (proposal.panel_shape) r.panel_shape = *proposal.panel_shape;
     }
   }
   return out;
@@ -124,33 +123,33 @@ std::vector<Refined> distinct_in_rectangle(std::vector<Refined> refined, const m
   return out;
 }
 
-// The best candidates' edge rounding profiled with their poses (shape_fit.hpp): each then carries
-// its best radius's pose, outline and model. Before any judgement of the outline: fitted with the
-// wrong rounding, even the right pose may fit its outline poorly. A candidate whose rounding a
-// previous registration profiled within same_pose of where it now stands keeps that profile: the
-// rounding is the panel's, and its pose has not moved enough to change what the profile saw.
+// The best candidates' shape (edge rounding, end caps) profiled with their poses (shape_fit.hpp):
+// each then carries its best shape's pose, outline and model. Before any judgement of the outline:
+// fitted with the wrong shape, even the right pose may fit its outline poorly. A candidate whose
+// shape a previous registration profiled within same_pose of where it now stands keeps that
+// profile: the shape is the panel's, and its pose has not moved enough to change what it saw.
 void fit_shapes(std::vector<Refined>& kept, const AntennaScene& s, const RegisterOptions& o) {
   for (std::size_t i = 0; i < std::min(kept.size(), o.shape_candidates); ++i) {
     auto& k = kept[i];
-    if (k.radius) {
+    if (k.panel_shape) {
       const Iso3& T = k.candidate.T_board_antenna;
-      const Iso3& U = k.radius->outline.T_board_antenna;
+      const Iso3& U = k.panel_shape->outline.T_board_antenna;
       if (rad2deg(rotation_distance(T.linear(), U.linear())) < o.same_pose_deg &&
           (T.translation() - U.translation()).norm() < o.same_pose_m) {
-        k.radius->outline = k.outline;
+        k.panel_shape->outline = k.outline;
         continue;
       }
     }
-    auto fit = fit_edge_radius(*k.model, k.candidate.T_board_antenna, s.views, s.intrinsics, polish_of(o.refine),
-                               o.evidence, o.edge_radius);
+    auto fit = fit_shape(*k.model, k.candidate.T_board_antenna, s.views, s.intrinsics, polish_of(o.refine),
+                               o.evidence, o.panel_shape);
     if (!fit.fitted || fit.outline.score >= k.outline.score) {
-      if (k.radius) k.radius->outline = k.outline;
+      if (k.panel_shape) k.panel_shape->outline = k.outline;
       continue;
     }
     k.outline = fit.outline;
     k.candidate.T_board_antenna = fit.outline.T_board_antenna;
     k.model = std::make_shared<const model::AntennaModel>(fit.model);
-    k.radius = std::move(fit);
+    k.panel_shape = std::move(fit);
   }
 }
 
@@ -205,7 +204,7 @@ AntennaRegistration select(const AntennaScene& s, std::vector<Refined> kept, con
   for (auto& k : kept) {
     const EvidenceJudge judge(*k.model, scene, o.evidence);
     candidates.push_back(k.candidate);
-    candidates.back().edge_radius = k.radius ? std::make_shared<const EdgeRadiusFit>(*k.radius) : nullptr;
+    candidates.back().panel_shape = k.panel_shape ? std::make_shared<const ShapeFit>(*k.panel_shape) : nullptr;
     candidates.back().evidence = judge(k.candidate.T_board_antenna);
     candidates.back().score = candidates.back().evidence.score(judge.options());
     twins.push_back(judge(turned_round(k.candidate.T_board_antenna)));
@@ -225,11 +224,11 @@ AntennaRegistration select(const AntennaScene& s, std::vector<Refined> kept, con
   const bool symmetric_ends = best.model->panel != nullptr;
   if (symmetric_ends) out.T_board_antenna = upright(out.T_board_antenna, s.up_board);
   out.rotation_covariance_board = best.outline.covariance.topLeftCorner<3, 3>();
-  if (best.radius) out.rotation_covariance_board += best.radius->spread_board;
+  if (best.panel_shape) out.rotation_covariance_board += best.panel_shape->spread_board;
   out.dilation_yaw_sigma_rad = best.outline.dilation_yaw_sigma_rad;
   out.outline_score = best.outline.score, out.outline_rms_px = best.outline.rms_px;
   out.outline_views = best.outline.views_used;
-  out.edge_radius = std::move(best.radius);
+  out.panel_shape = std::move(best.panel_shape);
   const auto facing_as_result = [&](std::size_t i) {
     const Iso3 rival = rival_facing(candidates[i].T_board_antenna, out.T_board_antenna);
     return symmetric_ends ? upright(rival, s.up_board) : rival;
@@ -270,7 +269,7 @@ OptionProblems RegisterOptions::Check() const {
   p.nest("search", search.Check());
   p.nest("evidence", evidence.Check());
   p.nest("selection", selection.Check());
-  p.nest("edge_radius", edge_radius.Check());
+  p.nest("panel_shape", panel_shape.Check());
   p.nest("mount_search", mount_search.Check());
   p.require(refine_candidates >= 1, "refine_candidates", "at least 1");
   p.require(same_pose_deg >= 0 && same_pose_m >= 0, "same_pose_deg, same_pose_m", "≥ 0");

@@ -1,8 +1,8 @@
 // The registration of one antenna model to its region (docs/non-contact.md, *Registration*):
 //
 //   strategies ──► candidate poses ──► each refined by its outline in every photo
-//   (outline search: outline_search.hpp;          (silhouette.hpp); the best ones' edge rounding
-//    the points' global start: global_start.hpp)   profiled with their pose (shape_fit.hpp)
+//   (outline search: outline_search.hpp;          (silhouette.hpp); the best ones' shape (edges,
+//    the points' global start: global_start.hpp)   end caps) profiled with their pose (shape_fit.hpp)
 //                                                         │
 //                                    evidence of each and of each turned round (pose_evidence.hpp)
 //                                                         │
@@ -64,7 +64,7 @@ struct RegisterOptions {
   }();
   EvidenceOptions evidence;
   SelectionOptions selection;
-  EdgeRadiusOptions edge_radius;                   // the best candidates' edge rounding profiled (shape_fit.hpp)
+  ShapeOptions panel_shape;  // the best candidates' shape profiled (shape_fit.hpp)
   reconstruction::MastSearchOptions mount_search;  // vertical structure behind and before the best
   std::size_t shape_candidates = 3;                // that many, by their outline
   double same_pose_deg = 2.0, same_pose_m = 0.03;  // refined candidates this close are one
@@ -94,7 +94,7 @@ struct AntennaRegistration {
   std::string why_not;  // when not found: why, and what would help
   Iso3 T_board_antenna = Iso3::Identity();
   Mat3 rotation_covariance_board = Mat3::Zero();  // rad², the outline's at the pose (and the edge radius's)
-  std::optional<EdgeRadiusFit> edge_radius;       // where the model's rounding was refitted
+  std::optional<ShapeFit> panel_shape;  // where the model's shape was refitted
   double dilation_yaw_sigma_rad = 0.0;            // SilhouetteResult's
   double outline_score = 1.0, outline_rms_px = 0.0;
   std::size_t outline_views = 0;
@@ -114,7 +114,7 @@ std::vector<PoseCandidate> propose_poses(const model::AntennaModel& model, const
 
 /// The proposals refined, judged and selected. A second registration of the same antenna in a
 /// scene that knows more (a mast, neighbours) passes the first one's candidates as proposals;
-/// those with a profiled edge rounding keep it (PoseCandidate::edge_radius).
+/// those with a profiled shape keep it (PoseCandidate::panel_shape).
 AntennaRegistration register_antenna(const model::AntennaModel& model, const AntennaScene& scene,
                                      const RegisterOptions& options, const std::vector<PoseCandidate>& proposals);
 

@@ -212,22 +212,13 @@ namespace {
 
 constexpr double kCrease = deg2rad(40.0);
 
-// The panel's parts in the antenna frame: its parametric panel, then the end caps (a panel of
-// the radome's section grown by the caps' thickness, end_cap_height_m long, flush with each end).
+// The panel's parts in the antenna frame: its parametric panel, then the end caps (a separate
+// moulding, so rendered as parts of their own).
 std::vector<model::Mesh> rendered_panel_parts(const SimAntenna& a) {
   std::vector<model::Mesh> parts{model::parametric_panel(a.spec).mesh_antenna};
-  const PanelFinish& f = a.finish;
-  if (f.end_cap_height_m <= 0.0) return parts;
-  model::PanelSpec cap;
-  cap.width_m = a.spec.width_m + 2 * f.end_cap_thickness_m, cap.depth_m = a.spec.depth_m + 2 * f.end_cap_thickness_m;
-  cap.height_m = f.end_cap_height_m;
-  cap.edge_radius_m = a.spec.edge_radius_m + f.end_cap_thickness_m;
-  cap.arc_segments = a.spec.arc_segments;
-  cap.bracket = false;
-  const model::Mesh cap_mesh = model::parametric_panel(cap).mesh_antenna;
-  for (const double side : {-1.0, 1.0})
-    parts.push_back(model::transformed(
-        cap_mesh, Iso3(Eigen::Translation3d(0.0, 0.0, side * (a.spec.height_m - f.end_cap_height_m) / 2))));
+  model::PanelSpec capped = a.spec;
+  capped.end_cap_height_m = a.finish.end_cap_height_m, capped.end_cap_rim_m = a.finish.end_cap_thickness_m;
+  for (auto& cap : model::end_cap_meshes(capped)) parts.push_back(std::move(cap));
   return parts;
 }
 
