@@ -73,7 +73,8 @@ TEST(ShapeFit, TheEndCapsRimIsFittedAndTheDowntiltWithIt) {
   const auto error = [&](const ShapeFit& f) {
     return rad2deg(rotation_distance(f.outline.T_board_antenna.linear(), s.T_board_antenna.linear()));
   };
-  std::printf("rim %.4f m, radius %.4f m, error %.2f°; without caps %.2f° (radius %.4f m)\n", fit.rim_m, fit.radius_m, error(fit), error(without), without.radius_m);
+  std::printf("rim %.4f m, radius %.4f m, error %.2f°; without caps %.2f° (radius %.4f m)\n", fit.rim_m, fit.radius_m,
+              error(fit), error(without), without.radius_m);
   EXPECT_LT(error(fit), 0.3);
   EXPECT_LT(2 * error(fit), error(without));
 }

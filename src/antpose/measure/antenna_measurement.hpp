@@ -77,13 +77,13 @@ struct AntennaMeasurement {
   registration::FrontBackCue front_back_cue = registration::FrontBackCue::kNone;
   AntennaAttitudeResult attitude;
   double fit_rmse_m = 0.0;
-  double fitness = 0.0;                      // share of region points within reach of the model
-  std::optional<double> silhouette_rms_px;   // the outline's edge RMS
-  std::optional<double> edge_radius_m;       // the radome's edge rounding fitted (a parametric panel)
-  std::optional<double> end_cap_rim_m;       // how far its end caps stand out of the radome (fitted)
+  double fitness = 0.0;                                // share of region points within reach of the model
+  std::optional<double> silhouette_rms_px;             // the outline's edge RMS
+  std::optional<double> edge_radius_m;                 // the radome's edge rounding fitted (a parametric panel)
+  std::optional<double> end_cap_rim_m;                 // how far its end caps stand out of the radome (fitted)
   std::vector<std::array<double, 2>> shapes_within_m;  // (radius, rim) the photos do not rule out
-  std::optional<reconstruction::Mast> mast;  // the mast found beside it, if any
-  std::size_t candidates = 0;                // poses proposed by the strategies
+  std::optional<reconstruction::Mast> mast;            // the mast found beside it, if any
+  std::size_t candidates = 0;                          // poses proposed by the strategies
   std::vector<registration::PoseCandidate> registration_candidates;  // refined and distinct (board frame)
   reconstruction::RegionReconstruction region;
   std::size_t region_view = 0;  // the rectangle's photo among the posed views

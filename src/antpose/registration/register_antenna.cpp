@@ -85,8 +85,8 @@ std::vector<Refined> refine_all(const std::shared_ptr<const model::AntennaModel>
   std::vector<Refined> out;
   for (const auto& proposal : proposals) {
     // A proposal whose shape was profiled is refined with that shape's model.
-    const auto with = proposal.panel_shape ? std::make_shared<const model::AntennaModel>(proposal.panel_shape->model)
-                                           : shared;
+    const auto with =
+        proposal.panel_shape ? std::make_shared<const model::AntennaModel>(proposal.panel_shape->model) : shared;
     auto descent = o.refine;
     descent.outline_box_m = model::outline_box(*with);
     auto polish = polish_of(descent);
@@ -140,8 +140,8 @@ void fit_shapes(std::vector<Refined>& kept, const AntennaScene& s, const Registe
         continue;
       }
     }
-    auto fit = fit_shape(*k.model, k.candidate.T_board_antenna, s.views, s.intrinsics, polish_of(o.refine),
-                               o.evidence, o.panel_shape);
+    auto fit = fit_shape(*k.model, k.candidate.T_board_antenna, s.views, s.intrinsics, polish_of(o.refine), o.evidence,
+                         o.panel_shape);
     if (!fit.fitted || fit.outline.score >= k.outline.score) {
       if (k.panel_shape) k.panel_shape->outline = k.outline;
       continue;

@@ -64,7 +64,7 @@ struct RegisterOptions {
   }();
   EvidenceOptions evidence;
   SelectionOptions selection;
-  ShapeOptions panel_shape;  // the best candidates' shape profiled (shape_fit.hpp)
+  ShapeOptions panel_shape;                        // the best candidates' shape profiled (shape_fit.hpp)
   reconstruction::MastSearchOptions mount_search;  // vertical structure behind and before the best
   std::size_t shape_candidates = 3;                // that many, by their outline
   double same_pose_deg = 2.0, same_pose_m = 0.03;  // refined candidates this close are one
@@ -94,7 +94,7 @@ struct AntennaRegistration {
   std::string why_not;  // when not found: why, and what would help
   Iso3 T_board_antenna = Iso3::Identity();
   Mat3 rotation_covariance_board = Mat3::Zero();  // rad², the outline's at the pose (and the edge radius's)
-  std::optional<ShapeFit> panel_shape;  // where the model's shape was refitted
+  std::optional<ShapeFit> panel_shape;            // where the model's shape was refitted
   double dilation_yaw_sigma_rad = 0.0;            // SilhouetteResult's
   double outline_score = 1.0, outline_rms_px = 0.0;
   std::size_t outline_views = 0;

@@ -53,7 +53,8 @@ struct Profile {
 // 0, step, .. (steps values).
 std::vector<double> grid(double largest, std::size_t steps) {
   std::vector<double> out;
-  for (std::size_t k = 0; k < steps; ++k) out.push_back(largest * static_cast<double>(k) / static_cast<double>(steps - 1));
+  for (std::size_t k = 0; k < steps; ++k)
+    out.push_back(largest * static_cast<double>(k) / static_cast<double>(steps - 1));
   return out;
 }
 
@@ -115,7 +116,7 @@ ShapeFit fit_shape(const model::AntennaModel& model, const Iso3& T_board_antenna
   const std::size_t n = radii.size();
   for (std::size_t j = 0; j < rims.size(); ++j)
     for (std::size_t i = 0; i < n; ++i) {
-      const Iso3& from = i > 0 ? p.results.back().T_board_antenna
+      const Iso3& from = i > 0   ? p.results.back().T_board_antenna
                          : j > 0 ? p.results[(j - 1) * n].T_board_antenna
                                  : T_board_antenna;
       p.refine(radii[i], rims[j], model, o, photos, from);

@@ -39,7 +39,7 @@ struct ShapeOptions {
 };
 
 struct ShapeFit {
-  bool fitted = false;  // false: not a parametric panel, or no shape refined to a usable outline
+  bool fitted = false;                 // false: not a parametric panel, or no shape refined to a usable outline
   double radius_m = 0.0, rim_m = 0.0;  // the best edge radius and end caps' rim
   model::AntennaModel model;           // the panel of that shape
   SilhouetteResult outline;            // its refinement
@@ -55,8 +55,7 @@ struct ShapeFit {
 /// that shape's model::outline_box), the shapes ruled out by `evidence`'s paired test. views,
 /// intrinsics as refine_by_silhouette.
 ShapeFit fit_shape(const model::AntennaModel& model, const Iso3& T_board_antenna,
-                              const std::vector<SilhouetteView>& views, const camera::CameraIntrinsics& intrinsics,
-                              const SilhouetteOptions& polish, const EvidenceOptions& evidence,
-                              const ShapeOptions& options);
+                   const std::vector<SilhouetteView>& views, const camera::CameraIntrinsics& intrinsics,
+                   const SilhouetteOptions& polish, const EvidenceOptions& evidence, const ShapeOptions& options);
 
 }  // namespace antpose::registration
