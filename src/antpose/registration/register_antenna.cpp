@@ -84,9 +84,10 @@ std::vector<Refined> refine_all(const std::shared_ptr<const model::AntennaModel>
                                 const std::vector<PoseCandidate>& proposals, const RegisterOptions& o) {
   std::vector<Refined> out;
   for (const auto& proposal : proposals) {
-    // A proposal whose shape was profiled is refined with that shape's model.
-    const auto with =
-        proposal.panel_shape ? std::make_shared<const model::AntennaModel>(proposal.panel_shape->model) : shared;
+    // A proposal whose shape was profiled is refined with that shape's model (shared, not copied).
+    const auto with = proposal.panel_shape ? std::shared_ptr<const model::AntennaModel>(proposal.panel_shape,
+                                                                                        &proposal.panel_shape->model)
+                                           : shared;
     auto descent = o.refine;
     descent.outline_box_m = model::outline_box(*with);
     auto polish = polish_of(descent);

@@ -93,7 +93,7 @@ struct AntennaRegistration {
   bool found = false;
   std::string why_not;  // when not found: why, and what would help
   Iso3 T_board_antenna = Iso3::Identity();
-  Mat3 rotation_covariance_board = Mat3::Zero();  // rad², the outline's at the pose (and the edge radius's)
+  Mat3 rotation_covariance_board = Mat3::Zero();  // rad², the outline's at the pose (and the shape's spread)
   std::optional<ShapeFit> panel_shape;            // where the model's shape was refitted
   double dilation_yaw_sigma_rad = 0.0;            // SilhouetteResult's
   double outline_score = 1.0, outline_rms_px = 0.0;
