@@ -18,8 +18,8 @@ using fixture::SyntheticScene;
 
 // What the reconstruction would give: points on the panel's faces the cameras see and on the
 // mast and arms behind it (where the fixture's mast stands), 5 mm noise.
-PointCloud region_points(const SyntheticScene& s) {
-  const auto model = model::parametric_panel({});
+PointCloud region_points(const SyntheticScene& s, const model::PanelSpec& panel) {
+  const auto model = model::parametric_panel(panel);
   const Iso3 T_antenna_board = s.T_board_antenna.inverse();
   std::vector<Vec3> viewpoints;
   for (const auto& v : s.views)
@@ -38,15 +38,15 @@ PointCloud region_points(const SyntheticScene& s) {
   return cloud;
 }
 
-AntennaScene antenna_scene(const SyntheticScene& s) {
+AntennaScene antenna_scene(const SyntheticScene& s, const model::PanelSpec& panel = {}) {
   AntennaScene a;
   a.views = s.views;
   a.intrinsics = s.intrinsics;
   for (const auto& v : s.views) a.viewpoints_board.push_back(camera::camera_centre(v.R_camera_board, v.t_camera_board));
   a.up_board = s.mast.up_board;
-  a.points_board = region_points(s);
+  a.points_board = region_points(s, panel);
   a.region_view = 3;
-  const Vec3 size = model::parametric_panel({}).size_m;
+  const Vec3 size = model::parametric_panel(panel).size_m;
   for (std::size_t v = 0; v < s.views.size(); ++v) {
     Eigen::AlignedBox2d box;
     for (const Vec3& c : model::box_corners(size))
@@ -112,6 +112,35 @@ TEST(RegisterAntenna, ASecondRegistrationKeepsTheProfiledRounding) {
   EXPECT_LT(rad2deg(rotation_distance(second.T_board_antenna.linear(), s.T_board_antenna.linear())), 1.0);
   EXPECT_NEAR(second.rotation_covariance_board.trace(), first.rotation_covariance_board.trace(),
               0.5 * first.rotation_covariance_board.trace());
+}
+
+// Started only in a mirror yaw's basin (yaw_turns.hpp), where the outline alone would keep it,
+// the registration turns that pose about its long axis: one of the turns finds the panel.
+TEST(RegisterAntenna, AStartInAMirrorYawsBasinIsTurnedToThePanel) {
+  fixture::SceneSpec spec;
+  spec.panel.width_m = 0.43, spec.panel.depth_m = 0.23;
+  spec.view_offsets_deg = {-4.0, -2.0, 0.0, 2.0, 4.0};
+  const SyntheticScene s = make_scene(spec);
+  AntennaScene scene = antenna_scene(s, spec.panel);
+  scene.mast = s.mast;
+  const auto model = model::parametric_panel(spec.panel);
+  const auto turns = mirror_turns(s.T_board_antenna, model::outline_box(model), scene.viewpoints_board);
+  const auto far = std::find_if(turns.begin(), turns.end(), [](double t) { return std::abs(t) > deg2rad(20.0); });
+  ASSERT_NE(far, turns.end());
+  Iso3 mirror = s.T_board_antenna;
+  mirror.linear() = exp_so3(*far * mirror.linear().col(2)) * mirror.linear();
+  const std::vector<PoseCandidate> start{{mirror, "a mirror of the panel", {}, 0.0, nullptr}};
+  RegisterOptions without;
+  without.turns.of_best = 0;
+  const auto stuck = register_antenna(model, scene, without, start);
+  ASSERT_TRUE(stuck.found) << stuck.why_not;
+  EXPECT_GT(rad2deg(box_angle(stuck.T_board_antenna.linear(), s.T_board_antenna.linear())), 10.0)
+      << "the mirror is a basin of its own";
+
+  const auto r = register_antenna(model, scene, {}, start);
+  ASSERT_TRUE(r.found) << r.why_not;
+  EXPECT_LT(rad2deg(rotation_distance(r.T_board_antenna.linear(), s.T_board_antenna.linear())), 1.0);
+  EXPECT_EQ(r.candidates[r.selection.best].strategy, "turned about its long axis");
 }
 
 // Where no pose meets its outline well, the poses that meet it faintly are measured, with a

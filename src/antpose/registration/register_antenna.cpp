@@ -104,7 +104,9 @@ std::vector<Refined> refine_all(const std::shared_ptr<const model::AntennaModel>
 }
 
 // Refined candidates that fit the rectangle, one per place: of those ending at the same box pose,
-// the one whose outline fits best. Best outline first.
+// the one whose outline fits best, or the best with a profiled shape where one has it (the shape is
+// the panel's; a descent with the model's guessed one is no better evidence of the pose). Best
+// outline first.
 std::vector<Refined> distinct_in_rectangle(std::vector<Refined> refined, const model::AntennaModel& model,
                                            const AntennaScene& s, const RegisterOptions& o) {
   std::sort(refined.begin(), refined.end(),
@@ -114,14 +116,60 @@ std::vector<Refined> distinct_in_rectangle(std::vector<Refined> refined, const m
     const Iso3& T = r.candidate.T_board_antenna;
     const auto [fill, centred] = roi_fill(model.size_m, T, s.views[s.region_view], s.intrinsics, s.roi);
     if (fill < o.min_roi_fill || !centred) continue;
-    const bool known = std::any_of(out.begin(), out.end(), [&](const Refined& k) {
+    const auto known = std::find_if(out.begin(), out.end(), [&](const Refined& k) {
       const Iso3& U = k.candidate.T_board_antenna;
       return rad2deg(box_angle(T.linear(), U.linear())) < o.same_pose_deg &&
              (T.translation() - U.translation()).norm() < o.same_pose_m;
     });
-    if (!known) out.push_back(std::move(r));
+    if (known == out.end())
+      out.push_back(std::move(r));
+    else if (r.panel_shape && !known->panel_shape)
+      *known = std::move(r);
   }
   return out;
+}
+
+// The best candidates turned about their long axis (yaw_turns.hpp) where no candidate stands yet.
+std::vector<PoseCandidate> turned_proposals(const std::vector<Refined>& kept, const AntennaScene& s,
+                                            const RegisterOptions& o) {
+  std::vector<PoseCandidate> out;
+  const auto near = [&](const Iso3& T, const Iso3& U) {
+    return rad2deg(box_angle(T.linear(), U.linear())) < o.turns.min_turn_deg;
+  };
+  for (std::size_t i = 0; i < std::min(kept.size(), o.turns.of_best); ++i) {
+    for (const Iso3& T : yaw_turns(kept[i].candidate.T_board_antenna, model::outline_box(*kept[i].model),
+                                   s.viewpoints_board, o.turns)) {
+      const bool known =
+          std::any_of(kept.begin(), kept.end(),
+                      [&](const Refined& k) { return near(T, k.candidate.T_board_antenna); }) ||
+          std::any_of(out.begin(), out.end(), [&](const PoseCandidate& c) { return near(T, c.T_board_antenna); });
+      if (!known) out.push_back({T, "turned about its long axis", {}, 0.0, nullptr});
+    }
+  }
+  return out;
+}
+
+// The proposals refined (refine_all), distinct in the rectangle, and the best turned about its
+// long axis (turned_proposals) and refined too. A second registration's proposals (a previous
+// one's candidates, some with a profiled shape) hold that registration's turns already.
+std::vector<Refined> refine_and_turn(const std::shared_ptr<const model::AntennaModel>& shared, const AntennaScene& s,
+                                     const std::vector<PoseCandidate>& proposals, const RegisterOptions& o) {
+  auto refined = refine_all(shared, s, proposals, o);
+  auto kept = distinct_in_rectangle(refined, *shared, s, o);
+  const bool again =
+      std::any_of(proposals.begin(), proposals.end(), [](const PoseCandidate& p) { return p.panel_shape != nullptr; });
+  const auto turned = again ? std::vector<PoseCandidate>{} : turned_proposals(kept, s, o);
+  if (turned.empty()) return kept;
+  // A turned start that descends back to a kept candidate's orientation found no other basin.
+  auto more = refine_all(shared, s, turned, o);
+  std::erase_if(more, [&](const Refined& m) {
+    return std::any_of(kept.begin(), kept.end(), [&](const Refined& k) {
+      return rad2deg(box_angle(m.candidate.T_board_antenna.linear(), k.candidate.T_board_antenna.linear())) <
+             o.same_pose_deg;
+    });
+  });
+  refined.insert(refined.end(), std::make_move_iterator(more.begin()), std::make_move_iterator(more.end()));
+  return distinct_in_rectangle(std::move(refined), *shared, s, o);
 }
 
 // The best candidates' shape (edge rounding, end caps) profiled with their poses (shape_fit.hpp):
@@ -129,17 +177,20 @@ std::vector<Refined> distinct_in_rectangle(std::vector<Refined> refined, const m
 // fitted with the wrong shape, even the right pose may fit its outline poorly. A candidate whose
 // shape a previous registration profiled within same_pose of where it now stands keeps that
 // profile: the shape is the panel's, and its pose has not moved enough to change what it saw.
+// Candidates that profiling brings onto one pose are one: the kept profile, else the better outline.
 void fit_shapes(std::vector<Refined>& kept, const AntennaScene& s, const RegisterOptions& o) {
-  for (std::size_t i = 0; i < std::min(kept.size(), o.shape_candidates); ++i) {
+  const auto same = [&](const Iso3& T, const Iso3& U) {
+    return rad2deg(rotation_distance(T.linear(), U.linear())) < o.same_pose_deg &&
+           (T.translation() - U.translation()).norm() < o.same_pose_m;
+  };
+  const std::size_t n = std::min(kept.size(), o.shape_candidates);
+  std::vector<bool> carried(n, false);
+  for (std::size_t i = 0; i < n; ++i) {
     auto& k = kept[i];
-    if (k.panel_shape) {
-      const Iso3& T = k.candidate.T_board_antenna;
-      const Iso3& U = k.panel_shape->outline.T_board_antenna;
-      if (rad2deg(rotation_distance(T.linear(), U.linear())) < o.same_pose_deg &&
-          (T.translation() - U.translation()).norm() < o.same_pose_m) {
-        k.panel_shape->outline = k.outline;
-        continue;
-      }
+    if (k.panel_shape && same(k.candidate.T_board_antenna, k.panel_shape->outline.T_board_antenna)) {
+      k.panel_shape->outline = k.outline;
+      carried[i] = true;
+      continue;
     }
     auto fit = fit_shape(*k.model, k.candidate.T_board_antenna, s.views, s.intrinsics, polish_of(o.refine), o.evidence,
                          o.panel_shape);
@@ -152,6 +203,16 @@ void fit_shapes(std::vector<Refined>& kept, const AntennaScene& s, const Registe
     k.model = std::make_shared<const model::AntennaModel>(fit.model);
     k.panel_shape = std::move(fit);
   }
+  std::vector<bool> merged(kept.size(), false);
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t j = i + 1; j < n; ++j) {
+      if (merged[i] || merged[j] || !same(kept[i].candidate.T_board_antenna, kept[j].candidate.T_board_antenna))
+        continue;
+      const bool keep_j = carried[j] != carried[i] ? carried[j] : kept[j].outline.score < kept[i].outline.score;
+      merged[keep_j ? i : j] = true;
+    }
+  std::size_t at = 0;
+  std::erase_if(kept, [&](const Refined&) { return merged[at++]; });
 }
 
 // The candidates whose outline meets the photos' edges (max_outline_score, min_outline_views), or
@@ -268,6 +329,7 @@ std::string to_string(RegistrationVerdict verdict) {
 OptionProblems RegisterOptions::Check() const {
   OptionProblems p;
   p.nest("search", search.Check());
+  p.nest("turns", turns.Check());
   p.nest("evidence", evidence.Check());
   p.nest("selection", selection.Check());
   p.nest("panel_shape", panel_shape.Check());
@@ -315,7 +377,7 @@ AntennaRegistration register_antenna(const model::AntennaModel& model, const Ant
   throw_unless_ok(o.Check(), "RegisterOptions");
   check_scene(s);
   const auto shared = std::make_shared<const model::AntennaModel>(model);
-  auto kept = distinct_in_rectangle(refine_all(shared, s, proposals, o), model, s, o);
+  auto kept = refine_and_turn(shared, s, proposals, o);
   fit_shapes(kept, s, o);
   const bool faint = keep_fitting_outlines(kept, o);
   if (kept.empty()) {

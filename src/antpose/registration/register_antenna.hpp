@@ -1,8 +1,10 @@
 // The registration of one antenna model to its region (docs/non-contact.md, *Registration*):
 //
 //   strategies ──► candidate poses ──► each refined by its outline in every photo
-//   (outline search: outline_search.hpp;          (silhouette.hpp); the best ones' shape (edges,
-//    the points' global start: global_start.hpp)   end caps) profiled with their pose (shape_fit.hpp)
+//   (outline search: outline_search.hpp;          (silhouette.hpp); the best one turned about its
+//    the points' global start: global_start.hpp)   long axis (yaw_turns.hpp) and refined too; the
+//                                                  best ones' shape (edges, end caps) profiled with
+//                                                  their pose (shape_fit.hpp)
 //                                                         │
 //                                    evidence of each and of each turned round (pose_evidence.hpp)
 //                                                         │
@@ -31,6 +33,7 @@
 #include "antpose/registration/pose_selection.hpp"
 #include "antpose/registration/shape_fit.hpp"
 #include "antpose/registration/silhouette.hpp"
+#include "antpose/registration/yaw_turns.hpp"
 
 namespace antpose::registration {
 
@@ -53,6 +56,7 @@ struct RegisterOptions {
   GlobalStartOptions points;
   std::size_t min_points_for_start = 200;
   std::size_t refine_candidates = 6;  // of each strategy, best first
+  YawTurnOptions turns;               // the best refined candidates turned about their long axis (yaw_turns.hpp)
   /// The refinement: no restarts of its own (the strategies span the yaws), a trust region on the
   /// rotation, and a neighbour or the mast may hide part of the outline.
   SilhouetteOptions refine = [] {
@@ -114,7 +118,8 @@ std::vector<PoseCandidate> propose_poses(const model::AntennaModel& model, const
 
 /// The proposals refined, judged and selected. A second registration of the same antenna in a
 /// scene that knows more (a mast, neighbours) passes the first one's candidates as proposals;
-/// those with a profiled shape keep it (PoseCandidate::panel_shape).
+/// those with a profiled shape keep it (PoseCandidate::panel_shape), and the best is not turned
+/// about its long axis again (the first registration's turns are among them).
 AntennaRegistration register_antenna(const model::AntennaModel& model, const AntennaScene& scene,
                                      const RegisterOptions& options, const std::vector<PoseCandidate>& proposals);
 
