@@ -104,7 +104,9 @@ TEST(RegisterAntenna, ASecondRegistrationKeepsTheProfiledRounding) {
                                       [](const PoseCandidate& c) { return c.panel_shape != nullptr; });
   EXPECT_GE(profiled, 1);
   scene.mast = s.mast;
-  const auto second = register_antenna(model::parametric_panel({}), scene, {}, first.candidates);
+  RegisterOptions again;
+  again.turns.of_best = 0;  // the first registration's turns are among its candidates
+  const auto second = register_antenna(model::parametric_panel({}), scene, again, first.candidates);
   ASSERT_TRUE(second.found) << second.why_not;
   ASSERT_TRUE(second.panel_shape);
   EXPECT_EQ(second.panel_shape->radius_m, first.panel_shape->radius_m);

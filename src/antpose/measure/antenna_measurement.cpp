@@ -275,13 +275,16 @@ void measure_antenna(AntennaMeasurement& m, const model::AntennaModel* model, co
     auto scene = registration_scene(*c.poses, c.up_board, m.region, m.region_view, rect_of(m.roi.roi), objects);
     auto proposals = registration::propose_poses(*model, scene, o.registration, !previous.empty());
     proposals.insert(proposals.end(), previous.begin(), previous.end());
-    auto r = registration::register_antenna(*model, scene, o.registration, proposals);
+    // A registration that starts from an earlier one's candidates has that one's turns among them.
+    auto again = o.registration;
+    again.turns.of_best = 0;
+    auto r = registration::register_antenna(*model, scene, previous.empty() ? o.registration : again, proposals);
     // A mast found beside the pose is known to a second registration of the same candidates.
     if (r.found && o.mast)
       if (auto mast = find_any_mast(m.region.cloud_board, r.T_board_antenna, model->size_m, c, objects, o)) {
         objects.mast = m.mast = std::move(mast);
         scene = registration_scene(*c.poses, c.up_board, m.region, m.region_view, rect_of(m.roi.roi), objects);
-        auto with_mast = registration::register_antenna(*model, scene, o.registration, r.candidates);
+        auto with_mast = registration::register_antenna(*model, scene, again, r.candidates);
         if (with_mast.found) r = std::move(with_mast);
       }
     if (!r.found) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <memory>
 
 #include <fmt/format.h>
@@ -20,6 +21,13 @@ struct Refined {
   std::shared_ptr<const model::AntennaModel> model;  // refined with: the panel's shape fitted, where it was
   std::optional<ShapeFit> panel_shape;
 };
+
+// Whether two poses put the box in one place: orientations within `max_deg` of each other, the box's
+// half turn about its long axis allowed (box_angle: the same outline), and centres within `max_m`.
+bool same_place(const Iso3& T, const Iso3& U, double max_deg,
+                double max_m = std::numeric_limits<double>::infinity()) {
+  return rad2deg(box_angle(T.linear(), U.linear())) < max_deg && (T.translation() - U.translation()).norm() < max_m;
+}
 
 // Where the outline search starts the box's centre besides the rectangle's own fit: the region's
 // points' centroid.
@@ -117,9 +125,7 @@ std::vector<Refined> distinct_in_rectangle(std::vector<Refined> refined, const m
     const auto [fill, centred] = roi_fill(model.size_m, T, s.views[s.region_view], s.intrinsics, s.roi);
     if (fill < o.min_roi_fill || !centred) continue;
     const auto known = std::find_if(out.begin(), out.end(), [&](const Refined& k) {
-      const Iso3& U = k.candidate.T_board_antenna;
-      return rad2deg(box_angle(T.linear(), U.linear())) < o.same_pose_deg &&
-             (T.translation() - U.translation()).norm() < o.same_pose_m;
+      return same_place(T, k.candidate.T_board_antenna, o.same_pose_deg, o.same_pose_m);
     });
     if (known == out.end())
       out.push_back(std::move(r));
@@ -133,9 +139,7 @@ std::vector<Refined> distinct_in_rectangle(std::vector<Refined> refined, const m
 std::vector<PoseCandidate> turned_proposals(const std::vector<Refined>& kept, const AntennaScene& s,
                                             const RegisterOptions& o) {
   std::vector<PoseCandidate> out;
-  const auto near = [&](const Iso3& T, const Iso3& U) {
-    return rad2deg(box_angle(T.linear(), U.linear())) < o.turns.min_turn_deg;
-  };
+  const auto near = [&](const Iso3& T, const Iso3& U) { return same_place(T, U, o.turns.min_turn_deg); };
   for (std::size_t i = 0; i < std::min(kept.size(), o.turns.of_best); ++i) {
     for (const Iso3& T : yaw_turns(kept[i].candidate.T_board_antenna, model::outline_box(*kept[i].model),
                                    s.viewpoints_board, o.turns)) {
@@ -150,26 +154,21 @@ std::vector<PoseCandidate> turned_proposals(const std::vector<Refined>& kept, co
 }
 
 // The proposals refined (refine_all), distinct in the rectangle, and the best turned about its
-// long axis (turned_proposals) and refined too. A second registration's proposals (a previous
-// one's candidates, some with a profiled shape) hold that registration's turns already.
+// long axis (turned_proposals) and refined too.
 std::vector<Refined> refine_and_turn(const std::shared_ptr<const model::AntennaModel>& shared, const AntennaScene& s,
                                      const std::vector<PoseCandidate>& proposals, const RegisterOptions& o) {
-  auto refined = refine_all(shared, s, proposals, o);
-  auto kept = distinct_in_rectangle(refined, *shared, s, o);
-  const bool again =
-      std::any_of(proposals.begin(), proposals.end(), [](const PoseCandidate& p) { return p.panel_shape != nullptr; });
-  const auto turned = again ? std::vector<PoseCandidate>{} : turned_proposals(kept, s, o);
+  auto kept = distinct_in_rectangle(refine_all(shared, s, proposals, o), *shared, s, o);
+  const auto turned = turned_proposals(kept, s, o);
   if (turned.empty()) return kept;
   // A turned start that descends back to a kept candidate's orientation found no other basin.
   auto more = refine_all(shared, s, turned, o);
   std::erase_if(more, [&](const Refined& m) {
     return std::any_of(kept.begin(), kept.end(), [&](const Refined& k) {
-      return rad2deg(box_angle(m.candidate.T_board_antenna.linear(), k.candidate.T_board_antenna.linear())) <
-             o.same_pose_deg;
+      return same_place(m.candidate.T_board_antenna, k.candidate.T_board_antenna, o.same_pose_deg);
     });
   });
-  refined.insert(refined.end(), std::make_move_iterator(more.begin()), std::make_move_iterator(more.end()));
-  return distinct_in_rectangle(std::move(refined), *shared, s, o);
+  kept.insert(kept.end(), std::make_move_iterator(more.begin()), std::make_move_iterator(more.end()));
+  return distinct_in_rectangle(std::move(kept), *shared, s, o);
 }
 
 // The best candidates' shape (edge rounding, end caps) profiled with their poses (shape_fit.hpp):
@@ -179,10 +178,7 @@ std::vector<Refined> refine_and_turn(const std::shared_ptr<const model::AntennaM
 // profile: the shape is the panel's, and its pose has not moved enough to change what it saw.
 // Candidates that profiling brings onto one pose are one: the kept profile, else the better outline.
 void fit_shapes(std::vector<Refined>& kept, const AntennaScene& s, const RegisterOptions& o) {
-  const auto same = [&](const Iso3& T, const Iso3& U) {
-    return rad2deg(rotation_distance(T.linear(), U.linear())) < o.same_pose_deg &&
-           (T.translation() - U.translation()).norm() < o.same_pose_m;
-  };
+  const auto same = [&](const Iso3& T, const Iso3& U) { return same_place(T, U, o.same_pose_deg, o.same_pose_m); };
   const std::size_t n = std::min(kept.size(), o.shape_candidates);
   std::vector<bool> carried(n, false);
   for (std::size_t i = 0; i < n; ++i) {
@@ -211,8 +207,10 @@ void fit_shapes(std::vector<Refined>& kept, const AntennaScene& s, const Registe
       const bool keep_j = carried[j] != carried[i] ? carried[j] : kept[j].outline.score < kept[i].outline.score;
       merged[keep_j ? i : j] = true;
     }
-  std::size_t at = 0;
-  std::erase_if(kept, [&](const Refined&) { return merged[at++]; });
+  std::vector<Refined> distinct;
+  for (std::size_t i = 0; i < kept.size(); ++i)
+    if (!merged[i]) distinct.push_back(std::move(kept[i]));
+  kept = std::move(distinct);
 }
 
 // The candidates whose outline meets the photos' edges (max_outline_score, min_outline_views), or

@@ -118,8 +118,8 @@ std::vector<PoseCandidate> propose_poses(const model::AntennaModel& model, const
 
 /// The proposals refined, judged and selected. A second registration of the same antenna in a
 /// scene that knows more (a mast, neighbours) passes the first one's candidates as proposals;
-/// those with a profiled shape keep it (PoseCandidate::panel_shape), and the best is not turned
-/// about its long axis again (the first registration's turns are among them).
+/// those with a profiled shape keep it (PoseCandidate::panel_shape). The first registration's
+/// turns are among them: the second needs none of its own (`turns.of_best = 0`).
 AntennaRegistration register_antenna(const model::AntennaModel& model, const AntennaScene& scene,
                                      const RegisterOptions& options, const std::vector<PoseCandidate>& proposals);
 
