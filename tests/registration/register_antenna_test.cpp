@@ -169,5 +169,33 @@ TEST(RegisterAntenna, AnOutlineMetOnlyFaintlyIsMeasuredWithAWarning) {
   EXPECT_NE(none.why_not.find("fits its outline"), std::string::npos) << none.why_not;
 }
 
+// The clear outline limit only warns: a candidate whose outline fits worse than it, but within the
+// faint limit, still takes part in the selection, where only the comparison with the best can rule
+// it out.
+TEST(RegisterAntenna, TheClearOutlineLimitCutsNoCandidate) {
+  const SyntheticScene s = make_scene();
+  AntennaScene scene = antenna_scene(s);
+  scene.mast = s.mast;
+  const auto all = register_antenna(model::parametric_panel({}), scene, {});
+  ASSERT_TRUE(all.found) << all.why_not;
+  const auto outline_of = [](const PoseCandidate& c) {
+    double sum = 0.0;
+    for (const double v : c.evidence.outline) sum += v;
+    return sum / static_cast<double>(c.evidence.outline.size());
+  };
+  const auto& best = all.candidates[all.selection.best];
+  const bool a_worse_outline = std::any_of(all.candidates.begin(), all.candidates.end(), [&](const PoseCandidate& c) {
+    return outline_of(c) > 1.5 * outline_of(best);
+  });
+  ASSERT_TRUE(a_worse_outline) << "the scene must give a candidate fitting its outline worse than the best";
+
+  RegisterOptions o;
+  o.max_outline_score = 1.2 * all.outline_score;
+  const auto r = register_antenna(model::parametric_panel({}), scene, o);
+  ASSERT_TRUE(r.found) << r.why_not;
+  EXPECT_EQ(r.candidates.size(), all.candidates.size());
+  EXPECT_TRUE(r.warnings.empty());
+}
+
 }  // namespace
 }  // namespace antpose::registration

@@ -213,17 +213,15 @@ void fit_shapes(std::vector<Refined>& kept, const AntennaScene& s, const Registe
   kept = std::move(distinct);
 }
 
-// The candidates whose outline meets the photos' edges (max_outline_score, min_outline_views), or
-// where none does, those that meet them faintly (max_faint_outline_score): true in that case.
-bool keep_fitting_outlines(std::vector<Refined>& kept, const RegisterOptions& o) {
-  const auto fits = [&](const Refined& k, double max_score) {
-    return k.outline.score <= max_score && k.outline.views_used >= o.min_outline_views;
-  };
-  const bool faint =
-      std::none_of(kept.begin(), kept.end(), [&](const Refined& k) { return fits(k, o.max_outline_score); });
-  const double limit = faint ? o.max_faint_outline_score : o.max_outline_score;
-  std::erase_if(kept, [&](const Refined& k) { return !fits(k, limit); });
-  return faint && !kept.empty();
+// The candidates whose outline meets the photos' edges at least faintly (max_faint_outline_score,
+// min_outline_views). No stricter cut by a fixed score: where the edges are faint or cluttered, the
+// true pose may fit its outline a little worse than a wrong one that meets a neighbour's or the
+// background's edges, and only the comparison of the two with its own noise (pose_selection.hpp)
+// may rule it out; a candidate cut here could never be the rival that makes the answer ambiguous.
+void keep_fitting_outlines(std::vector<Refined>& kept, const RegisterOptions& o) {
+  std::erase_if(kept, [&](const Refined& k) {
+    return k.outline.score > o.max_faint_outline_score || k.outline.views_used < o.min_outline_views;
+  });
 }
 
 // A rival's pose turned the way the result's front and back were decided: by the mast where it
@@ -377,7 +375,7 @@ AntennaRegistration register_antenna(const model::AntennaModel& model, const Ant
   const auto shared = std::make_shared<const model::AntennaModel>(model);
   auto kept = refine_and_turn(shared, s, proposals, o);
   fit_shapes(kept, s, o);
-  const bool faint = keep_fitting_outlines(kept, o);
+  keep_fitting_outlines(kept, o);
   if (kept.empty()) {
     AntennaRegistration none;
     none.proposed = proposals.size();
@@ -396,7 +394,7 @@ AntennaRegistration register_antenna(const model::AntennaModel& model, const Ant
   }
   auto out = select(s, std::move(kept), o);
   out.proposed = proposals.size();
-  if (faint)
+  if (out.outline_score > o.max_outline_score)
     out.warnings.push_back(fmt::format(
         "the model's outline meets the photos' edges only faintly (score {:.2f}; a clearly seen antenna scores "
         "under {:.2f}): its edges are faint against the background or partly hidden; the σ carries the poor fit, "

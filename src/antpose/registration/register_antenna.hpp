@@ -13,9 +13,11 @@
 // A candidate must fit the user's rectangle: its box, projected into the rectangle's photo, covers
 // at least `min_roi_fill` of it and has its centre inside it (the rectangle was drawn around this
 // antenna, so a pose on a neighbour or the mast does not qualify); and its outline must meet the
-// photos' edges (max_outline_score, min_outline_views; faintly, max_faint_outline_score, where no
-// pose meets them well). "Not found" is a value: the result says why and what photo or rectangle
-// would help.
+// photos' edges at least faintly (max_faint_outline_score, min_outline_views). Among those, only the
+// comparison with the best (pose_selection.hpp) rules a candidate out: a fixed score cut would drop
+// the true pose wherever the edges are faint or cluttered and a wrong pose meets other edges a
+// little better, leaving that wrong pose unique. "Not found" is a value: the result says why and
+// what photo or rectangle would help.
 #pragma once
 
 #include <cstddef>
@@ -73,13 +75,13 @@ struct RegisterOptions {
   std::size_t shape_candidates = 3;                // that many, by their outline
   double same_pose_deg = 2.0, same_pose_m = 0.03;  // refined candidates this close are one
   double min_roi_fill = 0.3;
-  /// A pose fits its outline where SilhouetteResult::score is at most `max_outline_score` (half of
-  /// the outline without an edge within the cutoff scores 0.5) in at least `min_outline_views`
-  /// photos. Where no pose does, the antenna's edges may still be faint against the background
-  /// (a grey radome before cloud) or partly hidden (a neighbour, foliage): the poses up to
-  /// `max_faint_outline_score` are kept, the outline covariance widens with their residuals, and
-  /// the result says so. Beyond that, under about a quarter of the outline meets an edge: no
-  /// object (a rectangle on the sky) or the wrong model.
+  /// A pose fits its outline clearly where SilhouetteResult::score is at most `max_outline_score`
+  /// (half of the outline without an edge within the cutoff scores 0.5) in at least
+  /// `min_outline_views` photos. A result beyond it may still be the antenna, its edges faint
+  /// against the background (a grey radome before cloud) or partly hidden (a neighbour, foliage):
+  /// its outline covariance widens with its residuals, and the result says so. Candidates up to
+  /// `max_faint_outline_score` take part in the selection; beyond that, under about a quarter of
+  /// the outline meets an edge: no object (a rectangle on the sky) or the wrong model.
   double max_outline_score = 0.5;
   double max_faint_outline_score = 0.8;
   std::size_t min_outline_views = 3;
