@@ -20,6 +20,68 @@ bool is_iso_date(const std::string& s) {
   }
 }
 
+// The declination and the expected field at the capture's site (WMM), and the measured field
+// checked against it: a field or dip off the model's marks a disturbed compass. Without a site, the
+// field is only checked against the Earth's range.
+void add_site_field(const Capture& input, const ContactOptions& options, ContactResult& r) {
+  if (input.site) {
+    Site site = *input.site;
+    if (site.date.empty()) {
+      if (input.time_origin && is_iso_date(*input.time_origin)) {
+        site.date = input.time_origin->substr(0, 10);
+      } else {
+        site.date = geomag::today_utc_iso();
+        r.warnings.push_back("the site has no date and the capture no time_origin: the magnetic model was "
+                             "evaluated for today, " + site.date);
+      }
+    }
+    geomag::SiteField field;
+    try {
+      field = geomag::site_field(geomag::MagneticModel::wmm2025(), site);
+    } catch (const std::invalid_argument& e) {
+      throw InputError(input.root / "capture.yaml", std::string("site: ") + e.what());
+    }
+    if (field.validity_warning) r.warnings.push_back(*field.validity_warning);
+    r.declination = field.declination;
+    r.expected_field_uT = field.elements.f_nT / 1000.0;
+    r.expected_dip = field.inclination;
+    r.sigma.declination = field.declination_sigma;
+    if (r.azimuth_magnetic) {
+      r.azimuth_true = wrap_2pi(*r.azimuth_magnetic + field.declination);
+      r.sigma.azimuth_true = std::hypot(r.sigma.azimuth, *r.sigma.declination);
+    }
+    const double rel = std::abs(r.field_uT - *r.expected_field_uT) / *r.expected_field_uT;
+    const double ddip = std::abs(r.dip - *r.expected_dip);
+    if (rel > options.field_tolerance) {
+      r.magnetic_disturbance = true;
+      r.warnings.push_back(fmt::format(
+          "magnetic disturbance: the measured field {:.1f} µT differs from the WMM's {:.1f} µT at the site by {:.0f}% "
+          "(limit {:.0f}%); the azimuth is unreliable (steel nearby, or an uncalibrated magnetometer: give "
+          "--imu-calibration)",
+          r.field_uT, *r.expected_field_uT, 100.0 * rel, 100.0 * options.field_tolerance));
+    }
+    if (ddip > options.dip_tolerance) {
+      r.magnetic_disturbance = true;
+      r.warnings.push_back(fmt::format(
+          "magnetic disturbance: the measured dip {:.1f}° differs from the WMM's inclination {:.1f}° at the site by "
+          "{:.1f}° (limit {:.1f}°); the azimuth is unreliable",
+          rad2deg(r.dip), rad2deg(*r.expected_dip), rad2deg(ddip), rad2deg(options.dip_tolerance)));
+    }
+  } else {
+    r.warnings.push_back(fmt::format(
+        "no site in the capture: no declination (true azimuth unavailable) and the field is only checked against "
+        "the Earth's range {:.0f}–{:.0f} µT",
+        options.plausible_field_min_uT, options.plausible_field_max_uT));
+    if (r.field_uT < options.plausible_field_min_uT || r.field_uT > options.plausible_field_max_uT) {
+      r.magnetic_disturbance = true;
+      r.warnings.push_back(fmt::format(
+          "magnetic disturbance: the measured field {:.1f} µT is outside the Earth's range {:.0f}–{:.0f} µT; the "
+          "azimuth is unreliable (steel nearby, or an uncalibrated magnetometer: give --imu-calibration)",
+          r.field_uT, options.plausible_field_min_uT, options.plausible_field_max_uT));
+    }
+  }
+}
+
 }  // namespace
 
 ContactResult measure_contact(const Capture& input, const ContactOptions& options) {
@@ -96,63 +158,7 @@ ContactResult measure_contact(const Capture& input, const ContactOptions& option
   r.sigma.roll = phone.tilt_sigma / cos_tilt;
   r.sigma.azimuth = std::hypot(phone.heading_sigma, phone.tilt_sigma * std::abs(std::tan(r.downtilt)));
 
-  // Declination and the expected field.
-  if (input.site) {
-    Site site = *input.site;
-    if (site.date.empty()) {
-      if (input.time_origin && is_iso_date(*input.time_origin)) {
-        site.date = input.time_origin->substr(0, 10);
-      } else {
-        site.date = geomag::today_utc_iso();
-        r.warnings.push_back("the site has no date and the capture no time_origin: the magnetic model was "
-                             "evaluated for today, " + site.date);
-      }
-    }
-    geomag::SiteField field;
-    try {
-      field = geomag::site_field(geomag::MagneticModel::wmm2025(), site);
-    } catch (const std::invalid_argument& e) {
-      throw InputError(input.root / "capture.yaml", std::string("site: ") + e.what());
-    }
-    if (field.validity_warning) r.warnings.push_back(*field.validity_warning);
-    r.declination = field.declination;
-    r.expected_field_uT = field.elements.f_nT / 1000.0;
-    r.expected_dip = field.inclination;
-    r.sigma.declination = field.declination_sigma;
-    if (r.azimuth_magnetic) {
-      r.azimuth_true = wrap_2pi(*r.azimuth_magnetic + field.declination);
-      r.sigma.azimuth_true = std::hypot(r.sigma.azimuth, *r.sigma.declination);
-    }
-    const double rel = std::abs(r.field_uT - *r.expected_field_uT) / *r.expected_field_uT;
-    const double ddip = std::abs(r.dip - *r.expected_dip);
-    if (rel > options.field_tolerance) {
-      r.magnetic_disturbance = true;
-      r.warnings.push_back(fmt::format(
-          "magnetic disturbance: the measured field {:.1f} µT differs from the WMM's {:.1f} µT at the site by {:.0f}% "
-          "(limit {:.0f}%); the azimuth is unreliable (steel nearby, or an uncalibrated magnetometer: give "
-          "--imu-calibration)",
-          r.field_uT, *r.expected_field_uT, 100.0 * rel, 100.0 * options.field_tolerance));
-    }
-    if (ddip > options.dip_tolerance) {
-      r.magnetic_disturbance = true;
-      r.warnings.push_back(fmt::format(
-          "magnetic disturbance: the measured dip {:.1f}° differs from the WMM's inclination {:.1f}° at the site by "
-          "{:.1f}° (limit {:.1f}°); the azimuth is unreliable",
-          rad2deg(r.dip), rad2deg(*r.expected_dip), rad2deg(ddip), rad2deg(options.dip_tolerance)));
-    }
-  } else {
-    r.warnings.push_back(fmt::format(
-        "no site in the capture: no declination (true azimuth unavailable) and the field is only checked against "
-        "the Earth's range {:.0f}–{:.0f} µT",
-        options.plausible_field_min_uT, options.plausible_field_max_uT));
-    if (r.field_uT < options.plausible_field_min_uT || r.field_uT > options.plausible_field_max_uT) {
-      r.magnetic_disturbance = true;
-      r.warnings.push_back(fmt::format(
-          "magnetic disturbance: the measured field {:.1f} µT is outside the Earth's range {:.0f}–{:.0f} µT; the "
-          "azimuth is unreliable (steel nearby, or an uncalibrated magnetometer: give --imu-calibration)",
-          r.field_uT, options.plausible_field_min_uT, options.plausible_field_max_uT));
-    }
-  }
+  add_site_field(input, options, r);
 
   if (phone.max_block_tilt > options.max_block_tilt || phone.max_block_heading > options.max_block_heading)
     r.warnings.push_back(fmt::format(
