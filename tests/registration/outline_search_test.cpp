@@ -76,6 +76,28 @@ TEST(OutlineSearch, FindsThePanelFromTheRectangleHoweverItIsDrawn) {
   }
 }
 
+// A pose proposed by its orientation, its centre a panel's depth and more off (a turn about another
+// orientation's centre): placed by the outline, the box lands on the panel; a start placed where
+// the panel is stays there.
+TEST(OutlineSearch, PlacesProposedOrientationsOnThePanel) {
+  const SyntheticScene s = make_scene();
+  const Vec3 size = model::parametric_panel({}).size_m;
+  const Vec3 off = s.T_board_antenna.linear() * Vec3(0.09, -0.08, 0.04);
+  Iso3 far = s.T_board_antenna, there = s.T_board_antenna;
+  far.translation() += off;
+  const OutlineSearchInput in = input_for(s, size, Vec3::Zero());
+  const auto placed = place_box_outlines(in, s.intrinsics, {}, {far, there});
+  ASSERT_EQ(placed.candidates.size(), 2u);
+  for (const auto& c : placed.candidates) {
+    EXPECT_LT(box_error_deg(c.T_board_antenna.linear(), s.T_board_antenna.linear()), 3.0);
+    EXPECT_LT((c.T_board_antenna.translation() - s.T_board_antenna.translation()).norm(), 0.03);
+    EXPECT_EQ(c.views, s.views.size());
+    EXPECT_LT(c.cost, 0.3);
+  }
+  EXPECT_GT(off.norm(), 0.12);
+  EXPECT_TRUE(place_box_outlines(in, s.intrinsics, {}, {}).candidates.empty());
+}
+
 TEST(OutlineSearch, ChecksItsOptionsAndInputs) {
   OutlineSearchOptions o;
   o.yaw_step_deg = 0;

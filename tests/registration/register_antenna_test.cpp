@@ -1,6 +1,7 @@
 #include "antpose/registration/register_antenna.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -60,10 +61,16 @@ AntennaScene antenna_scene(const SyntheticScene& s, const model::PanelSpec& pane
   return a;
 }
 
+// The same with the mast known beside the panel.
+AntennaScene antenna_scene_with_mast(const SyntheticScene& s, const model::PanelSpec& panel = {}) {
+  AntennaScene a = antenna_scene(s, panel);
+  a.mast = s.mast;
+  return a;
+}
+
 TEST(RegisterAntenna, FindsThePanelAndItsFrontWithTheMastKnown) {
   const SyntheticScene s = make_scene();
-  AntennaScene scene = antenna_scene(s);
-  scene.mast = s.mast;
+  const AntennaScene scene = antenna_scene_with_mast(s);
   const auto r = register_antenna(model::parametric_panel({}), scene, {});
   ASSERT_TRUE(r.found) << r.why_not;
   EXPECT_LT(rad2deg(rotation_distance(r.T_board_antenna.linear(), s.T_board_antenna.linear())), 1.0);
@@ -123,8 +130,7 @@ TEST(RegisterAntenna, AStartInAMirrorYawsBasinIsTurnedToThePanel) {
   spec.panel.width_m = 0.43, spec.panel.depth_m = 0.23;
   spec.view_offsets_deg = {-4.0, -2.0, 0.0, 2.0, 4.0};
   const SyntheticScene s = make_scene(spec);
-  AntennaScene scene = antenna_scene(s, spec.panel);
-  scene.mast = s.mast;
+  const AntennaScene scene = antenna_scene_with_mast(s, spec.panel);
   const auto model = model::parametric_panel(spec.panel);
   const auto turns = mirror_turns(s.T_board_antenna, model::outline_box(model), scene.viewpoints_board);
   const auto far = std::find_if(turns.begin(), turns.end(), [](double t) { return std::abs(t) > deg2rad(20.0); });
@@ -149,8 +155,7 @@ TEST(RegisterAntenna, AStartInAMirrorYawsBasinIsTurnedToThePanel) {
 // warning; beyond the faint limit nothing is. The limits are set about this scene's own outline.
 TEST(RegisterAntenna, AnOutlineMetOnlyFaintlyIsMeasuredWithAWarning) {
   const SyntheticScene s = make_scene();
-  AntennaScene scene = antenna_scene(s);
-  scene.mast = s.mast;
+  const AntennaScene scene = antenna_scene_with_mast(s);
   const auto clear = register_antenna(model::parametric_panel({}), scene, {});
   ASSERT_TRUE(clear.found) << clear.why_not;
   EXPECT_TRUE(clear.warnings.empty());
@@ -174,14 +179,15 @@ TEST(RegisterAntenna, AnOutlineMetOnlyFaintlyIsMeasuredWithAWarning) {
 // it out.
 TEST(RegisterAntenna, TheClearOutlineLimitCutsNoCandidate) {
   const SyntheticScene s = make_scene();
-  AntennaScene scene = antenna_scene(s);
-  scene.mast = s.mast;
+  const AntennaScene scene = antenna_scene_with_mast(s);
   const auto all = register_antenna(model::parametric_panel({}), scene, {});
   ASSERT_TRUE(all.found) << all.why_not;
-  const auto outline_of = [](const PoseCandidate& c) {
+  const auto outline_of = [](const PoseCandidate& c) {  // over the photos that measured it
     double sum = 0.0;
-    for (const double v : c.evidence.outline) sum += v;
-    return sum / static_cast<double>(c.evidence.outline.size());
+    int n = 0;
+    for (const double v : c.evidence.outline)
+      if (std::isfinite(v)) sum += v, ++n;
+    return n ? sum / n : 1.0;
   };
   const auto& best = all.candidates[all.selection.best];
   const bool a_worse_outline = std::any_of(all.candidates.begin(), all.candidates.end(), [&](const PoseCandidate& c) {

@@ -276,14 +276,58 @@ std::pair<double, std::size_t> BoxOutlineCost::operator()(const Iso3& T_board_an
   return {sum / static_cast<double>(views), views};
 }
 
-OutlineSearchResult search_box_outline(const OutlineSearchInput& input, const camera::CameraIntrinsics& intrinsics,
-                                       const OutlineSearchOptions& options) {
+namespace {
+
+// Steps as image motion in the region photo's maps: a few map pixels laterally to start; along the
+// line of sight the same motion of the box's edges takes depth/width times more.
+Probe place_from(const BoxOutlineCost& cost, const OutlineSearchInput& in, const Mat3& R, const Vec3& start,
+                 const OutlineSearchOptions& o, std::size_t& evaluations) {
+  const auto& region = (*in.views)[in.region_view];
+  const double map_px_m = in.box_size_m.x() / o.map_width_px;  // metres per map pixel at the box
+  const double depth = std::max(0.5, (region.R_camera_board * start + region.t_camera_board).z());
+  const double depth_per_width = depth / in.box_size_m.x();
+  const Vec3 step0(4 * map_px_m, 4 * map_px_m, 0.1 * depth);
+  const Vec3 step_min(o.min_step_map_px * map_px_m, o.min_step_map_px * map_px_m,
+                      std::min(0.05 * depth, o.min_step_map_px * map_px_m * depth_per_width));
+  return place_box(cost, R, start, region.R_camera_board.transpose(), step0, step_min, evaluations);
+}
+
+// Between the grid's orientations: each candidate polished over all six degrees of freedom, from
+// half a grid step down to `min_turn_deg`; best first.
+void polish_all(const BoxOutlineCost& cost, const OutlineSearchInput& in, const OutlineSearchOptions& o,
+                OutlineSearchResult& out) {
+  const auto& region = (*in.views)[in.region_view];
+  const double map_px = in.box_size_m.x() / o.map_width_px;
+  std::vector<std::size_t> evaluations(out.candidates.size(), 0);
+  cv::parallel_for_(cv::Range(0, static_cast<int>(out.candidates.size())), [&](const cv::Range& r) {
+    for (int i = r.start; i < r.end; ++i) {
+      auto& c = out.candidates[static_cast<std::size_t>(i)];
+      const double depth =
+          std::max(0.5, (region.R_camera_board * c.T_board_antenna.translation() + region.t_camera_board).z());
+      const Probe p = polish_box(cost, c.T_board_antenna, region.R_camera_board.transpose(),
+                                 Vec3(map_px, map_px, 0.02 * depth), Vec3::Constant(o.min_step_map_px * map_px),
+                                 deg2rad(o.yaw_step_deg / 2), deg2rad(o.min_turn_deg),
+                                 evaluations[static_cast<std::size_t>(i)]);
+      c.cost = p.cost, c.views = p.views;
+    }
+  });
+  for (const auto e : evaluations) out.evaluations += e;
+  std::stable_sort(out.candidates.begin(), out.candidates.end(),
+                   [](const OutlineCandidate& a, const OutlineCandidate& b) { return a.cost < b.cost; });
+}
+
+void check_input(const OutlineSearchInput& input, const OutlineSearchOptions& options) {
   throw_unless_ok(options.Check(), "OutlineSearchOptions");
   if (input.views && input.region_view >= input.views->size())
     throw std::invalid_argument("search_box_outline: the region view is out of range");
+}
+
+}  // namespace
+
+OutlineSearchResult search_box_outline(const OutlineSearchInput& input, const camera::CameraIntrinsics& intrinsics,
+                                       const OutlineSearchOptions& options) {
+  check_input(input, options);
   const BoxOutlineCost cost(input, intrinsics, options);
-  const auto& region = (*input.views)[input.region_view];
-  const Mat3 R_board_camera = region.R_camera_board.transpose();
   const auto orientations = hanging_orientations(input.up_board, options);
   // Every orientation from every start: the given ones, and the one swept along the rectangle's
   // centre ray (nullopt here).
@@ -292,9 +336,6 @@ OutlineSearchResult search_box_outline(const OutlineSearchInput& input, const ca
     for (const Vec3& start : input.starts_board) tasks.emplace_back(o, start);
     if (input.roi) tasks.emplace_back(o, std::nullopt);
   }
-  // Steps as image motion in the region photo's maps: a few map pixels laterally to start; along
-  // the line of sight the same motion of the box's edges takes depth/width times more.
-  const double map_px_m = input.box_size_m.x() / options.map_width_px;  // metres per map pixel at the box
   std::vector<Probe> best(tasks.size());
   std::vector<std::size_t> evaluations(tasks.size(), 0);
   cv::parallel_for_(cv::Range(0, static_cast<int>(tasks.size())), [&](const cv::Range& r) {
@@ -303,13 +344,7 @@ OutlineSearchResult search_box_outline(const OutlineSearchInput& input, const ca
       const Mat3& R = orientations[tasks[k].first];
       const auto start =
           tasks[k].second ? tasks[k].second : swept_start(cost, input, intrinsics, R, options, evaluations[k]);
-      if (!start) continue;
-      const double depth = std::max(0.5, (region.R_camera_board * *start + region.t_camera_board).z());
-      const double depth_per_width = depth / input.box_size_m.x();
-      const Vec3 step0(4 * map_px_m, 4 * map_px_m, 0.1 * depth);
-      const Vec3 step_min(options.min_step_map_px * map_px_m, options.min_step_map_px * map_px_m,
-                          std::min(0.05 * depth, options.min_step_map_px * map_px_m * depth_per_width));
-      best[k] = place_box(cost, R, *start, R_board_camera, step0, step_min, evaluations[k]);
+      if (start) best[k] = place_from(cost, input, R, *start, options, evaluations[k]);
     }
   });
   OutlineSearchResult out;
@@ -333,26 +368,29 @@ OutlineSearchResult search_box_outline(const OutlineSearchInput& input, const ca
     c.cost = best[i].cost, c.views = best[i].views;
     out.candidates.push_back(c);
   }
-  // Between the grid's orientations: each candidate polished over all six degrees of freedom,
-  // from half a grid step down to `min_turn_deg`.
-  const double map_px = input.box_size_m.x() / options.map_width_px;
-  cv::parallel_for_(cv::Range(0, static_cast<int>(out.candidates.size())), [&](const cv::Range& r) {
+  polish_all(cost, input, options, out);
+  return out;
+}
+
+OutlineSearchResult place_box_outlines(const OutlineSearchInput& input, const camera::CameraIntrinsics& intrinsics,
+                                       const OutlineSearchOptions& options, const std::vector<Iso3>& starts) {
+  check_input(input, options);
+  const BoxOutlineCost cost(input, intrinsics, options);
+  OutlineSearchResult out;
+  out.candidates.resize(starts.size());
+  std::vector<std::size_t> evaluations(starts.size(), 0);
+  cv::parallel_for_(cv::Range(0, static_cast<int>(starts.size())), [&](const cv::Range& r) {
     for (int i = r.start; i < r.end; ++i) {
-      auto& c = out.candidates[static_cast<std::size_t>(i)];
-      const double depth =
-          std::max(0.5, (region.R_camera_board * c.T_board_antenna.translation() + region.t_camera_board).z());
-      std::size_t evaluations_here = 0;
-      const Probe p = polish_box(cost, c.T_board_antenna, R_board_camera, Vec3(map_px, map_px, 0.02 * depth),
-                                 Vec3::Constant(options.min_step_map_px * map_px), deg2rad(options.yaw_step_deg / 2),
-                                 deg2rad(options.min_turn_deg), evaluations_here);
-      c.cost = p.cost, c.views = p.views;
-      evaluations[static_cast<std::size_t>(i)] += evaluations_here;
+      const auto k = static_cast<std::size_t>(i);
+      const Mat3 R = starts[k].linear();
+      const Probe p = place_from(cost, input, R, starts[k].translation(), options, evaluations[k]);
+      out.candidates[k].T_board_antenna.linear() = R;
+      out.candidates[k].T_board_antenna.translation() = p.p_board;
+      out.candidates[k].cost = p.cost, out.candidates[k].views = p.views;
     }
   });
-  out.evaluations = 0;
   for (const auto e : evaluations) out.evaluations += e;
-  std::sort(out.candidates.begin(), out.candidates.end(),
-            [](const OutlineCandidate& a, const OutlineCandidate& b) { return a.cost < b.cost; });
+  polish_all(cost, input, options, out);
   return out;
 }
 

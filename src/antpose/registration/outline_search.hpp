@@ -83,6 +83,13 @@ struct OutlineSearchResult {
 OutlineSearchResult search_box_outline(const OutlineSearchInput& input, const camera::CameraIntrinsics& intrinsics,
                                        const OutlineSearchOptions& options);
 
+/// Each start's centre searched at the start's own orientation, from the start's centre, by the
+/// search's compass search, then polished over all six degrees of freedom like the search's
+/// candidates: the outline's own placement of poses another strategy proposes by their
+/// orientation (their centres may belong to another orientation's basin). Best first.
+OutlineSearchResult place_box_outlines(const OutlineSearchInput& input, const camera::CameraIntrinsics& intrinsics,
+                                       const OutlineSearchOptions& options, const std::vector<Iso3>& starts);
+
 /// The chamfer cost of one box pose against prepared maps (for tests and reports): as the search
 /// scores it.
 class BoxOutlineCost {

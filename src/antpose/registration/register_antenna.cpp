@@ -36,8 +36,7 @@ std::vector<Vec3> search_starts(const AntennaScene& s) {
   return {centroid(s.points_board.points)};
 }
 
-std::vector<PoseCandidate> from_outline(const model::AntennaModel& model, const AntennaScene& s,
-                                        const RegisterOptions& o) {
+OutlineSearchInput outline_input(const model::AntennaModel& model, const AntennaScene& s, const RegisterOptions& o) {
   OutlineSearchInput in;
   in.box_size_m = model.size_m;
   in.views = &s.views;
@@ -48,8 +47,13 @@ std::vector<PoseCandidate> from_outline(const model::AntennaModel& model, const 
   in.starts_board = search_starts(s);
   in.roi = s.roi;
   in.min_roi_fill = o.min_roi_fill;
+  return in;
+}
+
+std::vector<PoseCandidate> from_outline(const model::AntennaModel& model, const AntennaScene& s,
+                                        const RegisterOptions& o) {
   std::vector<PoseCandidate> out;
-  for (const auto& c : search_box_outline(in, s.intrinsics, o.search).candidates) {
+  for (const auto& c : search_box_outline(outline_input(model, s, o), s.intrinsics, o.search).candidates) {
     if (out.size() >= o.refine_candidates) break;
     out.push_back({c.T_board_antenna, "outline search", {}, c.cost, nullptr});
   }
@@ -153,12 +157,39 @@ std::vector<PoseCandidate> turned_proposals(const std::vector<Refined>& kept, co
   return out;
 }
 
+// The turned starts placed again by the outline at their own orientation (outline_search.hpp's
+// place_box_outlines): a turn about the candidate's centre keeps a centre that belongs to the
+// candidate's orientation, and where the two orientations' basins lie further apart than the
+// refinement reaches, the turned orientation's own is never found. Those that land where a kept
+// candidate or a turned start already stands add nothing.
+std::vector<PoseCandidate> placed_turns(const std::vector<PoseCandidate>& turned, const std::vector<Refined>& kept,
+                                        const model::AntennaModel& model, const AntennaScene& s,
+                                        const RegisterOptions& o) {
+  if (!o.place_turns || turned.empty()) return {};
+  std::vector<Iso3> starts, taken;
+  for (const auto& t : turned) starts.push_back(t.T_board_antenna);
+  for (const auto& k : kept) taken.push_back(k.candidate.T_board_antenna);
+  taken.insert(taken.end(), starts.begin(), starts.end());
+  std::vector<PoseCandidate> out;
+  for (const auto& c : place_box_outlines(outline_input(model, s, o), s.intrinsics, o.search, starts).candidates) {
+    const bool known = std::any_of(taken.begin(), taken.end(), [&](const Iso3& U) {
+      return same_place(c.T_board_antenna, U, o.same_pose_deg, o.same_pose_m);
+    });
+    if (c.views < o.search.min_views || known) continue;
+    out.push_back({c.T_board_antenna, "turned and placed by the outline", {}, c.cost, nullptr});
+    taken.push_back(c.T_board_antenna);
+  }
+  return out;
+}
+
 // The proposals refined (refine_all), distinct in the rectangle, and the best turned about its
-// long axis (turned_proposals) and refined too.
+// long axis (turned_proposals, placed_turns) and refined too.
 std::vector<Refined> refine_and_turn(const std::shared_ptr<const model::AntennaModel>& shared, const AntennaScene& s,
                                      const std::vector<PoseCandidate>& proposals, const RegisterOptions& o) {
   auto kept = distinct_in_rectangle(refine_all(shared, s, proposals, o), *shared, s, o);
-  const auto turned = turned_proposals(kept, s, o);
+  auto turned = turned_proposals(kept, s, o);
+  const auto placed = placed_turns(turned, kept, *shared, s, o);
+  turned.insert(turned.end(), placed.begin(), placed.end());
   if (turned.empty()) return kept;
   // A turned start that descends back to a kept candidate's orientation found no other basin.
   auto more = refine_all(shared, s, turned, o);

@@ -2,9 +2,10 @@
 //
 //   strategies ──► candidate poses ──► each refined by its outline in every photo
 //   (outline search: outline_search.hpp;          (silhouette.hpp); the best one turned about its
-//    the points' global start: global_start.hpp)   long axis (yaw_turns.hpp) and refined too; the
-//                                                  best ones' shape (edges, end caps) profiled with
-//                                                  their pose (shape_fit.hpp)
+//    the points' global start: global_start.hpp)   long axis (yaw_turns.hpp), each turn also placed
+//                                                  by the outline at its own orientation, and
+//                                                  refined too; the best ones' shape (edges, end
+//                                                  caps) profiled with their pose (shape_fit.hpp)
 //                                                         │
 //                                    evidence of each and of each turned round (pose_evidence.hpp)
 //                                                         │
@@ -59,6 +60,7 @@ struct RegisterOptions {
   std::size_t min_points_for_start = 200;
   std::size_t refine_candidates = 6;  // of each strategy, best first
   YawTurnOptions turns;               // the best refined candidates turned about their long axis (yaw_turns.hpp)
+  bool place_turns = true;            // each turned start also placed by the outline at its own orientation
   /// The refinement: no restarts of its own (the strategies span the yaws), a trust region on the
   /// rotation, and a neighbour or the mast may hide part of the outline.
   SilhouetteOptions refine = [] {
