@@ -14,7 +14,10 @@
 // the classic distribution. ANTPOSE_MEASURE_SET=FIRST-LAST (e.g. 7101-7112) replaces it by a set of
 // wide sites drawn alike (rooftop and ground alternating, 1–3 antennas, a magnetised mast at every
 // third; 2 MP photos, plain radomes and side-by-side panels forced in turn), and
-// ANTPOSE_MEASURE_RESULTS=DIR keeps each site's rows there for MeasureSiteSet.
+// ANTPOSE_MEASURE_RESULTS=DIR keeps each site's rows there for MeasureSiteSet. With
+// ANTPOSE_MEASURE_DISTRIBUTION=classic the set is drawn from the classic distribution by the same
+// rule, nothing forced (the regression sets); ANTPOSE_MEASURE_REGRESSION=all adds to the everyday
+// list the classic regression sites whose fault a shorter test guards.
 #include <cmath>
 #include <algorithm>
 #include <cstdlib>
@@ -52,13 +55,17 @@ struct Site {
 
 void PrintTo(const Site& s, std::ostream* os) { *os << s.name; }
 
-// The set's k-th wide site (the file comment).
-Site wide_site(int seed, int k) {
+// The set's k-th site (the file comment): setting, compass and panels by k; a wide site also has
+// 2 MP photos, a plain radome or side-by-side panels forced in turn.
+Site set_site(int seed, int k, const std::string& distribution) {
   Site s;
   s.seed = seed;
+  s.distribution = distribution;
   s.ground = k % 2 == 1;
   s.disturbance = k % 3 == 2;
   s.antennas = 1 + (k / 2) % 3;
+  s.name = fmt::format("{}_{}", distribution, seed);
+  if (distribution != "wide") return s;
   switch (k % 4) {
     case 0:
       s.forced = "--photo-scale 0.41";
@@ -72,7 +79,6 @@ Site wide_site(int seed, int k) {
     default:
       break;
   }
-  s.name = fmt::format("wide_{}", seed);
   return s;
 }
 
@@ -82,7 +88,7 @@ std::vector<Site> everyday_sites() {
   // radome from the ground, three panels on a rooftop, and one whose front and back no cue decides
   // (its refusal must say what to do).
   for (const int k : {0, 1, 4, 6, 7}) {
-    sites.push_back(wide_site(7001 + k, k));
+    sites.push_back(set_site(7001 + k, k, "wide"));
     if (k == 1) sites.back().warns = "the radome shows little texture, so the angles rest on its outline";
   }
   // Classic regression sites, each measuring the antenna its fault was found on.
@@ -97,6 +103,15 @@ std::vector<Site> everyday_sites() {
   sites.push_back(classic(3711, false, false, 3, 2));
   sites.push_back(classic(5111, false, false, 3, 3));
   sites.push_back(classic(5810, true, false, 2, 1));
+  // The rest of the regression sites, each also guarded by a shorter test or an everyday site that
+  // takes the same path.
+  if (const char* all = std::getenv("ANTPOSE_MEASURE_REGRESSION"); all && std::string(all) == "all") {
+    sites.push_back(classic(3312, true, true, 3, 2));
+    sites.push_back(classic(3208, true, false, 1, 0));
+    sites.push_back(classic(3811, false, false, 3, 3));
+    sites.push_back(classic(3802, true, false, 1, 0));
+    sites.push_back(classic(6109, false, true, 2, 2));
+  }
   return sites;
 }
 
@@ -105,8 +120,10 @@ std::vector<Site> sites() {
   if (!set) return everyday_sites();
   int first = 0, last = 0;
   if (std::sscanf(set, "%d-%d", &first, &last) != 2 || last < first) return everyday_sites();
+  const char* kind = std::getenv("ANTPOSE_MEASURE_DISTRIBUTION");
+  const std::string distribution = kind && std::string(kind) == "classic" ? "classic" : "wide";
   std::vector<Site> out;
-  for (int seed = first; seed <= last; ++seed) out.push_back(wide_site(seed, seed - first));
+  for (int seed = first; seed <= last; ++seed) out.push_back(set_site(seed, seed - first, distribution));
   return out;
 }
 
