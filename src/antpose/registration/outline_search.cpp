@@ -4,6 +4,7 @@
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
+#include <string>
 
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
@@ -316,17 +317,17 @@ void polish_all(const BoxOutlineCost& cost, const OutlineSearchInput& in, const 
                    [](const OutlineCandidate& a, const OutlineCandidate& b) { return a.cost < b.cost; });
 }
 
-void check_input(const OutlineSearchInput& input, const OutlineSearchOptions& options) {
+void check_input(const OutlineSearchInput& input, const OutlineSearchOptions& options, const char* caller) {
   throw_unless_ok(options.Check(), "OutlineSearchOptions");
   if (input.views && input.region_view >= input.views->size())
-    throw std::invalid_argument("search_box_outline: the region view is out of range");
+    throw std::invalid_argument(std::string(caller) + ": the region view is out of range");
 }
 
 }  // namespace
 
 OutlineSearchResult search_box_outline(const OutlineSearchInput& input, const camera::CameraIntrinsics& intrinsics,
                                        const OutlineSearchOptions& options) {
-  check_input(input, options);
+  check_input(input, options, "search_box_outline");
   const BoxOutlineCost cost(input, intrinsics, options);
   const auto orientations = hanging_orientations(input.up_board, options);
   // Every orientation from every start: the given ones, and the one swept along the rectangle's
@@ -374,7 +375,7 @@ OutlineSearchResult search_box_outline(const OutlineSearchInput& input, const ca
 
 OutlineSearchResult place_box_outlines(const OutlineSearchInput& input, const camera::CameraIntrinsics& intrinsics,
                                        const OutlineSearchOptions& options, const std::vector<Iso3>& starts) {
-  check_input(input, options);
+  check_input(input, options, "place_box_outlines");
   const BoxOutlineCost cost(input, intrinsics, options);
   OutlineSearchResult out;
   out.candidates.resize(starts.size());
