@@ -3,6 +3,7 @@
 //   antpose bench orientation DIR...          every orientation estimator, BROAD metric, throughput
 //   antpose bench orientation-grid DIR...     Madgwick beta × zeta sweep (thesis §4.6), SVG heat maps
 //   antpose bench registration [SHARED]      antpose's ICP against PCL's and Open3D's (docs/benchmarks.md)
+//   antpose bench measure DIR... --device D   the non-contact measurement on simulated sites (cmd_bench_measure.cpp)
 #include <unistd.h>
 
 #include <algorithm>
@@ -24,16 +25,9 @@
 #include "commands.hpp"
 
 namespace antpose::cli {
-namespace {
+
 namespace fs = std::filesystem;
 
-struct StaticBenchArgs {
-  std::vector<std::string> dirs;
-  double rest_s = 20.0;
-  double window_s = 1.0;
-};
-
-// A capture folder, or a folder of capture folders (sorted by name).
 std::vector<fs::path> capture_folders(const std::vector<std::string>& dirs) {
   std::vector<fs::path> out;
   for (const auto& d : dirs) {
@@ -52,6 +46,14 @@ std::vector<fs::path> capture_folders(const std::vector<std::string>& dirs) {
   }
   return out;
 }
+
+namespace {
+
+struct StaticBenchArgs {
+  std::vector<std::string> dirs;
+  double rest_s = 20.0;
+  double window_s = 1.0;
+};
 
 void run_static_bench(const StaticBenchArgs& args) {
   orientation::RestBenchmarkOptions options;
@@ -310,6 +312,8 @@ void add_bench_command(CLI::App& app) {
       ->capture_default_str();
   rb->add_option("--json", rargs->json, "write the results as JSON");
   rb->callback([rargs] { run_registration_bench(*rargs); });
+
+  add_bench_measure_command(*bench);
 }
 
 }  // namespace antpose::cli

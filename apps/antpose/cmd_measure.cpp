@@ -15,6 +15,7 @@
 #include "antpose/camera/board.hpp"
 #include "antpose/imu/imu_calibration.hpp"
 #include "antpose/io/text_file.hpp"
+#include "antpose/measure/device_setup.hpp"
 #include "antpose/measure/non_contact.hpp"
 #include "antpose/measure/report.hpp"
 #include "antpose/model/antenna_model.hpp"
@@ -65,18 +66,7 @@ std::vector<model::AntennaModel> load_models(const MeasureArgs& a) {
 }
 
 measure::NonContactSetup setup_from(const MeasureArgs& a, const store::DeviceProfile& device, const fs::path& where) {
-  measure::NonContactSetup s;
-  if (!device.camera)
-    throw InputError(where, "the device has no camera intrinsics: run 'antpose calibrate camera --device' first");
-  if (!device.camera_imu)
-    throw InputError(where,
-                     "the device has no camera–IMU rotation (R_device_camera): run 'antpose calibrate joint "
-                     "--device' first; the nominal layout is off by degrees on real phones");
-  s.intrinsics = device.camera->intrinsics;
-  s.camera_imu.R_device_camera = device.camera_imu->R_device_camera;
-  s.camera_imu.time_offset_s = device.camera_imu->time_offset_s;
-  if (device.camera_imu->rotation_sigma_rad)
-    s.camera_imu.covariance = device.camera_imu->rotation_sigma_rad->cwiseAbs2().asDiagonal();
+  measure::NonContactSetup s = measure::device_setup(device, where);
   s.board = camera::read_board(fs::path(a.capture) / "board.yaml");
   s.models = load_models(a);
   for (const auto& r : a.rois) s.rois.push_back(measure::parse_roi(r));

@@ -1,6 +1,7 @@
 // The CLI is a thin layer: each verb parses its options and calls the library.
 #pragma once
 
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -24,9 +25,14 @@ void add_device_command(CLI::App& app);
 void add_calibrate_camera_command(CLI::App& calibrate);
 void add_calibrate_joint_command(CLI::App& calibrate);
 void add_simulate_capture_command(CLI::App& simulate);
+void add_bench_measure_command(CLI::App& bench);
 
 /// Prints each warning as "warning: <file>:<line>: <message>" on stderr.
 void print_warnings(const Diagnostics& diagnostics);
+
+/// Capture folders (holding capture.yaml) and the capture folders inside other folders, sorted by
+/// name within each; InputError for a folder that is neither.
+std::vector<std::filesystem::path> capture_folders(const std::vector<std::string>& dirs);
 
 /// The non-empty items of a comma-separated option value ("a,b,,c" → a, b, c).
 std::vector<std::string> split_list(const std::string& text);

@@ -2,6 +2,7 @@
 // number it cannot support. One small simulated antenna capture serves all cases; the device
 // profile is the simulator's truth (these tests check messages, not accuracy: that is the long
 // acceptance test's job).
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -81,6 +82,42 @@ TEST_F(MeasureCli, RoiOnTheSkyFailsThatAntennaWithItsReason) {
   EXPECT_TRUE(j["antennas"][0]["azimuth_magnetic_deg"].is_null());
   EXPECT_THAT(j["antennas"][0]["error"].get<std::string>(),
               HasSubstr("nothing in the rectangle fits the outline of the model"));
+}
+
+TEST_F(MeasureCli, TheBenchmarkScoresWhatMeasureAnswers) {
+  // `bench measure` runs the measurement of `measure` on the truth's rectangles and models: its
+  // errors are that answer less the truth, and its stages are the measurement's.
+  const auto json = *dir_ / "answer.json";
+  const auto bench_json = *dir_ / "bench.json";
+  test::run_cli(measure(capture(), fmt::format("--model {} --roi {} --json '{}'", model_, roi_, json.string())));
+  const auto r = test::run_cli(fmt::format("bench measure '{}' --device '{}' --json '{}'", capture().string(),
+                                           device().string(), bench_json.string()));
+  ASSERT_EQ(r.status, 0) << r.out << r.err;
+  EXPECT_THAT(r.out, HasSubstr("1 sites: median"));
+  const auto answer = nlohmann::json::parse(io::read_text(json))["antennas"][0];
+  const auto truth = YAML::LoadFile((capture() / "truth/scene.yaml").string())["antennas"][0];
+  const auto site = nlohmann::json::parse(io::read_text(bench_json))["sites"][0];
+  EXPECT_EQ(site["photos"], 6);
+  EXPECT_GT(site["seconds"].get<double>(), 0.0);
+  for (const char* stage : {"board poses", "dense stereo", "registration"})
+    EXPECT_TRUE(site["stage_seconds"].contains(stage)) << stage << " in " << site["stage_seconds"];
+  ASSERT_EQ(site["antennas"].size(), 1u);
+  const auto scored = site["antennas"][0];
+  ASSERT_TRUE(scored["refused"].is_null()) << scored["refused"];
+  EXPECT_EQ(scored["verdict"], answer["verdict"]);
+  const double azimuth = answer["azimuth_magnetic_deg"].get<double>() - truth["azimuth_magnetic_deg"].as<double>();
+  EXPECT_NEAR(scored["azimuth_error_deg"].get<double>(), std::remainder(azimuth, 360.0), 1e-6);
+  EXPECT_NEAR(scored["downtilt_error_deg"].get<double>(),
+              answer["downtilt_deg"].get<double>() - truth["downtilt_deg"].as<double>(), 1e-6);
+  EXPECT_NEAR(scored["azimuth_sigma_deg"].get<double>(), answer["uncertainty_deg"]["azimuth"].get<double>(), 1e-6);
+}
+
+TEST_F(MeasureCli, TheBenchmarkNamesACaptureWithoutTruth) {
+  const auto cap = copy("no-truth");
+  fs::remove(cap / "truth" / "scene.yaml");
+  const auto r = test::run_cli(fmt::format("bench measure '{}' --device '{}'", cap.string(), device().string()));
+  EXPECT_EQ(r.status, 2) << r.out << r.err;
+  EXPECT_THAT(r.err, HasSubstr((cap / "truth" / "scene.yaml").string()));
 }
 
 TEST_F(MeasureCli, ARectangleTheAntennaFillsLittleOfIsNamed) {
