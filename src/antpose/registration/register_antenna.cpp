@@ -182,23 +182,43 @@ std::vector<PoseCandidate> placed_turns(const std::vector<PoseCandidate>& turned
   return out;
 }
 
+// The best candidates slid along their long axis (axis_slide.hpp) where their outline scores better.
+std::vector<PoseCandidate> slid_proposals(const std::vector<Refined>& kept, const AntennaScene& s,
+                                          const RegisterOptions& o) {
+  std::vector<PoseCandidate> out;
+  for (std::size_t i = 0; i < std::min(kept.size(), o.slide.of_best); ++i) {
+    auto outline = o.refine;
+    outline.outline_box_m = model::outline_box(*kept[i].model);
+    if (const auto T = slide_along_axis(kept[i].model->mesh_antenna, kept[i].candidate.T_board_antenna, s.views,
+                                        s.intrinsics, outline, o.slide))
+      out.push_back({*T, "slid along its long axis", {}, 0.0, kept[i].candidate.panel_shape});
+  }
+  return out;
+}
+
 // The proposals refined (refine_all), distinct in the rectangle, and the best turned about its
-// long axis (turned_proposals, placed_turns) and refined too.
+// long axis (turned_proposals, placed_turns) or slid along it (slid_proposals) and refined too.
 std::vector<Refined> refine_and_turn(const std::shared_ptr<const model::AntennaModel>& shared, const AntennaScene& s,
                                      const std::vector<PoseCandidate>& proposals, const RegisterOptions& o) {
   auto kept = distinct_in_rectangle(refine_all(shared, s, proposals, o), *shared, s, o);
   auto turned = turned_proposals(kept, s, o);
   const auto placed = placed_turns(turned, kept, *shared, s, o);
   turned.insert(turned.end(), placed.begin(), placed.end());
-  if (turned.empty()) return kept;
-  // A turned start that descends back to a kept candidate's orientation found no other basin.
+  const auto slid = slid_proposals(kept, s, o);
+  if (turned.empty() && slid.empty()) return kept;
+  // A turned start that descends back to a kept candidate's orientation found no other basin; a
+  // slid one that descends back to a kept candidate's place found no other.
   auto more = refine_all(shared, s, turned, o);
-  std::erase_if(more, [&](const Refined& m) {
+  auto moved = refine_all(shared, s, slid, o);
+  const auto known = [&](const Refined& m, double max_m) {
     return std::any_of(kept.begin(), kept.end(), [&](const Refined& k) {
-      return same_place(m.candidate.T_board_antenna, k.candidate.T_board_antenna, o.same_pose_deg);
+      return same_place(m.candidate.T_board_antenna, k.candidate.T_board_antenna, o.same_pose_deg, max_m);
     });
-  });
+  };
+  std::erase_if(more, [&](const Refined& m) { return known(m, std::numeric_limits<double>::infinity()); });
+  std::erase_if(moved, [&](const Refined& m) { return known(m, o.same_pose_m); });
   kept.insert(kept.end(), std::make_move_iterator(more.begin()), std::make_move_iterator(more.end()));
+  kept.insert(kept.end(), std::make_move_iterator(moved.begin()), std::make_move_iterator(moved.end()));
   return distinct_in_rectangle(std::move(kept), *shared, s, o);
 }
 
@@ -357,6 +377,7 @@ OptionProblems RegisterOptions::Check() const {
   OptionProblems p;
   p.nest("search", search.Check());
   p.nest("turns", turns.Check());
+  p.nest("slide", slide.Check());
   p.nest("evidence", evidence.Check());
   p.nest("selection", selection.Check());
   p.nest("panel_shape", panel_shape.Check());

@@ -3,7 +3,8 @@
 //   strategies ──► candidate poses ──► each refined by its outline in every photo
 //   (outline search: outline_search.hpp;          (silhouette.hpp); the best one turned about its
 //    the points' global start: global_start.hpp)   long axis (yaw_turns.hpp), each turn also placed
-//                                                  by the outline at its own orientation, and
+//                                                  by the outline at its own orientation; the
+//                                                  best ones slid along it (axis_slide.hpp); each
 //                                                  refined too; the best ones' shape (edges, end
 //                                                  caps) profiled with their pose (shape_fit.hpp)
 //                                                         │
@@ -30,6 +31,7 @@
 #include "antpose/model/antenna_model.hpp"
 #include "antpose/reconstruction/mast.hpp"
 #include "antpose/reconstruction/mast_search.hpp"
+#include "antpose/registration/axis_slide.hpp"
 #include "antpose/registration/global_start.hpp"
 #include "antpose/registration/outline_search.hpp"
 #include "antpose/registration/pose_evidence.hpp"
@@ -61,6 +63,7 @@ struct RegisterOptions {
   std::size_t refine_candidates = 6;  // of each strategy, best first
   YawTurnOptions turns;               // the best refined candidates turned about their long axis (yaw_turns.hpp)
   bool place_turns = true;            // each turned start also placed by the outline at its own orientation
+  AxisSlideOptions slide;             // the best refined candidates slid along their long axis (axis_slide.hpp)
   /// The refinement: no restarts of its own (the strategies span the yaws), a trust region on the
   /// rotation, and a neighbour or the mast may hide part of the outline.
   SilhouetteOptions refine = [] {

@@ -315,7 +315,7 @@ SilhouetteResult refine_by_silhouette(const model::Mesh& mesh_antenna, const Iso
   SilhouetteResult result;
   result.T_board_antenna = T_board_antenna_initial;
   const Pose start{T_board_antenna_initial.linear(), T_board_antenna_initial.translation()};
-  const PreparedViews ready = prepare_views(m, start, views, intrinsics, options, options.max_level, result.warnings);
+  const PreparedViews ready = prepare_views(m, {start}, views, intrinsics, options, options.max_level, result.warnings);
   Descender descender(m, ready, intrinsics, options, prior);
 
   Descent best = descender.descend(start);
@@ -357,29 +357,41 @@ SilhouetteResult refine_by_silhouette(const model::Mesh& mesh_antenna, const Iso
   return result;
 }
 
+std::vector<OutlineEvaluation> evaluate_outlines(const model::Mesh& mesh_antenna, const std::vector<Iso3>& poses,
+                                                 const std::vector<SilhouetteView>& views,
+                                                 const camera::CameraIntrinsics& intrinsics,
+                                                 const SilhouetteOptions& options) {
+  if (mesh_antenna.triangles.empty()) throw std::invalid_argument("evaluate_outline: the mesh has no triangles");
+  if (poses.empty()) return {};
+  const EdgeMesh m = weld(mesh_antenna);
+  std::vector<Pose> at;
+  for (const Iso3& T : poses) at.push_back({T.linear(), T.translation()});
+  std::vector<std::string> warnings;
+  const PreparedViews ready = prepare_views(m, at, views, intrinsics, options, 0, warnings);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  std::vector<OutlineEvaluation> out;
+  for (const Pose& pose : at) {
+    const Gathered g = gather_all(m, pose, ready.views, intrinsics, 0, options.fine_search_px, options);
+    OutlineEvaluation& e = out.emplace_back();
+    for (std::size_t i = 0; i < views.size(); ++i) {
+      const OutlineCounts& c = g.per_view_counts[i];
+      double sum = 0.0;
+      for (const auto& smp : g.per_view[i]) sum += edge_cost(smp.r, options);
+      const double unfound = static_cast<double>(c.candidates - g.per_view[i].size());
+      e.cost.push_back(c.candidates ? (sum + unfound) / static_cast<double>(c.candidates) : nan);
+      const auto found = static_cast<double>(g.per_view[i].size());
+      e.placement.push_back(found > 0 ? sum / found : nan);
+      e.samples.push_back(c.candidates);
+    }
+    e.score = score(g, options);
+  }
+  return out;
+}
+
 OutlineEvaluation evaluate_outline(const model::Mesh& mesh_antenna, const Iso3& T_board_antenna,
                                    const std::vector<SilhouetteView>& views, const camera::CameraIntrinsics& intrinsics,
                                    const SilhouetteOptions& options) {
-  if (mesh_antenna.triangles.empty()) throw std::invalid_argument("evaluate_outline: the mesh has no triangles");
-  const EdgeMesh m = weld(mesh_antenna);
-  const Pose pose{T_board_antenna.linear(), T_board_antenna.translation()};
-  OutlineEvaluation out;
-  std::vector<std::string> warnings;
-  const PreparedViews ready = prepare_views(m, pose, views, intrinsics, options, 0, warnings);
-  const Gathered g = gather_all(m, pose, ready.views, intrinsics, 0, options.fine_search_px, options);
-  const double nan = std::numeric_limits<double>::quiet_NaN();
-  for (std::size_t i = 0; i < views.size(); ++i) {
-    const OutlineCounts& c = g.per_view_counts[i];
-    double sum = 0.0;
-    for (const auto& smp : g.per_view[i]) sum += edge_cost(smp.r, options);
-    const double unfound = static_cast<double>(c.candidates - g.per_view[i].size());
-    out.cost.push_back(c.candidates ? (sum + unfound) / static_cast<double>(c.candidates) : nan);
-    const auto found = static_cast<double>(g.per_view[i].size());
-    out.placement.push_back(found > 0 ? sum / found : nan);
-    out.samples.push_back(c.candidates);
-  }
-  out.score = score(g, options);
-  return out;
+  return evaluate_outlines(mesh_antenna, {T_board_antenna}, views, intrinsics, options).front();
 }
 
 }  // namespace antpose::registration

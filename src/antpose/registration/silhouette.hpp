@@ -198,4 +198,11 @@ OutlineEvaluation evaluate_outline(const model::Mesh& mesh_antenna, const Iso3& 
                                    const std::vector<SilhouetteView>& views, const camera::CameraIntrinsics& intrinsics,
                                    const SilhouetteOptions& options);
 
+/// evaluate_outline at each of `poses`, which lie close together (a line search's): the photos are
+/// prepared once, cropped around all of them.
+std::vector<OutlineEvaluation> evaluate_outlines(const model::Mesh& mesh_antenna, const std::vector<Iso3>& poses,
+                                                 const std::vector<SilhouetteView>& views,
+                                                 const camera::CameraIntrinsics& intrinsics,
+                                                 const SilhouetteOptions& options);
+
 }  // namespace antpose::registration

@@ -93,17 +93,17 @@ Gathered gather_all(const EdgeMesh& m, const Pose& pose, const std::vector<Prepa
                     const camera::CameraIntrinsics& K, int level, double search_px, const SilhouetteOptions& o,
                     bool with_attachments = false);
 
-// The photos prepared for the outline of the model at `pose`: each cropped (its ROI, or the
-// model's projected box plus a margin), as gradient pyramids in linear intensity (edges are
-// located there: in encoded values the outline's width, and so the yaw, would be biased), masked
-// where known objects are. `top`: the coarsest level, where the model's narrowest projection is
-// still min_coarse_width_px wide (at most `max_level`).
+// The photos prepared for the outline of the model at `poses` (one or more close together): each
+// cropped (its ROI, or the union of the model's projected boxes plus a margin), as gradient
+// pyramids in linear intensity (edges are located there: in encoded values the outline's width,
+// and so the yaw, would be biased), masked where known objects are. `top`: the coarsest level,
+// where the narrowest side of that union is still min_coarse_width_px wide (at most `max_level`).
 struct PreparedViews {
   std::vector<PreparedView> views;
   int top = 0;
 };
 
-PreparedViews prepare_views(const EdgeMesh& m, const Pose& pose, const std::vector<SilhouetteView>& views,
+PreparedViews prepare_views(const EdgeMesh& m, const std::vector<Pose>& poses, const std::vector<SilhouetteView>& views,
                             const camera::CameraIntrinsics& intrinsics, const SilhouetteOptions& options, int max_level,
                             std::vector<std::string>& warnings);
 

@@ -301,7 +301,7 @@ Gathered gather_all(const EdgeMesh& m, const Pose& pose, const std::vector<Prepa
   return g;
 }
 
-PreparedViews prepare_views(const EdgeMesh& m, const Pose& pose, const std::vector<SilhouetteView>& views,
+PreparedViews prepare_views(const EdgeMesh& m, const std::vector<Pose>& poses, const std::vector<SilhouetteView>& views,
                             const camera::CameraIntrinsics& intrinsics, const SilhouetteOptions& options, int max_level,
                             std::vector<std::string>& warnings) {
   PreparedViews out;
@@ -316,7 +316,11 @@ PreparedViews prepare_views(const EdgeMesh& m, const Pose& pose, const std::vect
     auto& v = prepared[i];
     v.R_cb = in.R_camera_board;
     v.t_cb = in.t_camera_board;
-    const auto box = projected_box(intrinsics, v, m, pose);
+    auto box = projected_box(intrinsics, v, m, poses.front());
+    for (std::size_t k = 1; k < poses.size() && box; ++k) {
+      const auto more = projected_box(intrinsics, v, m, poses[k]);
+      box = more ? std::optional<cv::Rect2d>(*box | *more) : std::nullopt;
+    }
     if (!box) {
       warnings.push_back(fmt::format("view {}: the model lies (partly) behind the camera; skipped", i));
       continue;
