@@ -486,6 +486,7 @@ TEST(ReconstructRegion, SeenInOneViewFails) {
     FAIL();
   } catch (const MeasurementError& e) {
     EXPECT_NE(std::string(e.what()).find("seen in only 1 photo"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("add photos that show the whole antenna"), std::string::npos) << e.what();
   }
 }
 

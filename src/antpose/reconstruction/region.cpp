@@ -404,6 +404,16 @@ std::vector<Vec3> statistical_outlier_removal(const std::vector<Vec3>& points, i
 
 namespace {
 
+// The refusal of a region that fewer than two photos see (`counted`: what counts as seeing it),
+// with what to do.
+MeasurementError seen_by_too_few(const std::string& photo, std::size_t seen, const char* counted) {
+  return MeasurementError(
+      fmt::format("the region of {} is seen in only {} photo(s) ({}); at least 2 are needed: add photos that show "
+                  "the whole antenna from a few steps aside, or draw its rectangle in a photo taken nearer the "
+                  "middle of the walk",
+                  photo, seen, counted));
+}
+
 // What one object's reconstruction gave: its region, or why not — no object's depth among the
 // features, or too few points on its surface (the region then holds those it gave). `range`: the
 // depth range it was sought in.
@@ -482,7 +492,7 @@ ObjectAttempt reconstruct_object(const std::vector<PosedView>& views, const Refi
     if (sees) pairs.push_back({int(roi_view), v, {}});
   }
   if (pairs.empty())
-    throw MeasurementError(fmt::format("the region of {} is seen in only 1 photo; at least 2 are needed", ref.name));
+    throw seen_by_too_few(ref.name, 1, "any of it inside the frame");
   cv::parallel_for_(cv::Range(0, int(pairs.size())), [&](const cv::Range& r) {
     for (int k = r.start; k < r.end; ++k) {
       const int v = pairs[k].view_b;
@@ -573,8 +583,7 @@ ObjectAttempt reconstruct_object(const std::vector<PosedView>& views, const Refi
     seen_by.push_back(v);
   }
   if (seen_by.size() < 2)
-    throw MeasurementError(
-        fmt::format("the region of {} is seen in only {} photo(s); at least 2 are needed", ref.name, seen_by.size()));
+    throw seen_by_too_few(ref.name, seen_by.size(), "at least half of it inside the frame");
 
   // 3. Dense stereo on pairs with a useful triangulation angle (3°–40° at the object, the best
   //    two partners per view, preferring ~15°: wide enough for depth, narrow enough to match).
