@@ -76,6 +76,32 @@ TEST(PoseSelection, ANearPoseThatMeetsItsEdgesBetterIsANearRival) {
   EXPECT_EQ(s.near_rivals[0], 1u);
 }
 
+// A pose further off whose outline costs more in every photo (a stretch of it too faint to meet an
+// edge) but that the region's points fit much better: the winner's lower score rests on the weight
+// of the points against the outline, which is known only within a range, and at its end the pose
+// is not ruled out: a rival. One the points fit only a little better is ruled out at every weight.
+TEST(PoseSelection, AnotherYawThePointsFitMuchBetterIsARival) {
+  auto with_points = [](PoseCandidate c, std::vector<double> points) {
+    c.evidence.points = std::move(points);
+    c.score = c.evidence.score({});
+    return c;
+  };
+  const std::vector<PoseCandidate> candidates{
+      with_points(facing(40, Vec3::Zero(), {0.28, 0.26, 0.27, 0.29, 0.25, 0.27}), {0.55, 0.52, 0.58, 0.54}),
+      with_points(facing(65, Vec3::Zero(), {0.64, 0.60, 0.66, 0.62, 0.63, 0.61}), {0.38, 0.36, 0.40, 0.37}),
+      with_points(facing(100, Vec3::Zero(), {0.64, 0.60, 0.66, 0.62, 0.63, 0.61}), {0.52, 0.49, 0.55, 0.51})};
+  const std::vector<PoseEvidence> twins(candidates.size(), side({0.0, 0.0}));
+  EXPECT_TRUE(compare_shape(candidates[0].evidence, candidates[1].evidence, {}).decisive);
+  const Selection s = select_pose(candidates, twins, std::nullopt, {}, {});
+  EXPECT_EQ(s.best, 0u);
+  ASSERT_EQ(s.rivals.size(), 1u);
+  EXPECT_EQ(s.rivals[0], 1u);
+
+  EvidenceOptions exact;  // with the weight taken as known, the score rules both out
+  exact.points_weight_range = 1.0;
+  EXPECT_TRUE(select_pose(candidates, twins, std::nullopt, exact, {}).rivals.empty());
+}
+
 TEST(PoseSelection, AMastBehindDecidesFrontAndBackWhateverTheDowntilt) {
   // The panel 0.4 m north of the mast; as registered it faces south, at its mast: turned round
   // it faces north, away from it. An uptilt as registered changes nothing.

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -149,6 +150,36 @@ TEST(RegisterAntenna, AStartInAMirrorYawsBasinIsTurnedToThePanel) {
   ASSERT_TRUE(r.found) << r.why_not;
   EXPECT_LT(rad2deg(rotation_distance(r.T_board_antenna.linear(), s.T_board_antenna.linear())), 1.0);
   EXPECT_EQ(r.candidates[r.selection.best].strategy, "turned about its long axis");
+}
+
+// The points' starts are also candidates where the points place them: with the region's points
+// 5 cm off across the panel, the outline's descent takes the pose to the photos' edges, and the
+// points' own pose is kept beside it, not descended.
+TEST(RegisterAntenna, ThePointsPoseIsKeptWhereThePointsPlaceIt) {
+  const SyntheticScene s = make_scene();
+  AntennaScene scene = antenna_scene_with_mast(s);
+  const Vec3 shift = 0.05 * s.T_board_antenna.linear().col(0);
+  for (Vec3& p : scene.points_board.points) p += shift;
+  // The distance of the nearest held candidate from where the points lie.
+  const auto held = [&](const AntennaRegistration& r) {
+    double nearest = std::numeric_limits<double>::infinity();
+    for (const auto& c : r.candidates)
+      if (c.strategy == "as the points place it" &&
+          rad2deg(rotation_distance(c.T_board_antenna.linear(), s.T_board_antenna.linear())) < 2.0)
+        nearest = std::min(nearest, (c.T_board_antenna.translation() - s.T_board_antenna.translation() - shift).norm());
+    return nearest;
+  };
+  RegisterOptions o;  // the points' pose meets few of the fixture's sharp edges: kept however faint
+  o.max_faint_outline_score = 1.0;
+  const auto r = register_antenna(model::parametric_panel({}), scene, o);
+  ASSERT_TRUE(r.found) << r.why_not;
+  EXPECT_LT((r.T_board_antenna.translation() - s.T_board_antenna.translation()).norm(), 0.01);
+  EXPECT_LT(held(r), 0.01);
+
+  o.hold_points_poses = false;
+  const auto without = register_antenna(model::parametric_panel({}), scene, o);
+  ASSERT_TRUE(without.found) << without.why_not;
+  EXPECT_FALSE(std::isfinite(held(without)));
 }
 
 // Where no pose meets its outline well, the poses that meet it faintly are measured, with a

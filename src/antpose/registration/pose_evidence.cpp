@@ -85,6 +85,7 @@ OptionProblems EvidenceOptions::Check() const {
   p.require(point_truncation_m > 0, "point_truncation_m", "positive");
   p.require(points_weight >= 0 && side_mount_weight >= 0 && side_mount_outline_weight >= 0,
             "points_weight, side_mount_weight, side_mount_outline_weight", "≥ 0");
+  p.require(points_weight_range >= 1, "points_weight_range", "at least 1");
   p.require(model_spacing_m > 0, "model_spacing_m", "positive");
   p.require(mount_gap_m >= 0 && mount_depth_m > mount_gap_m, "mount_gap_m, mount_depth_m", "0 ≤ gap < depth");
   p.require(decisive_z > 0 && min_difference >= 0, "decisive_z, min_difference", "z > 0, difference ≥ 0");

@@ -31,6 +31,17 @@ bool placement_leans_to(const PoseEvidence& other, const PoseEvidence& best, con
   return c.units > 1 && c.difference < -c.standard_error;
 }
 
+// Whether `best` beats `other` decisively with the points weighed against the outline at each end
+// of the range the score's weight is known within (EvidenceOptions::points_weight_range).
+bool ruled_out_at_every_weight(const PoseEvidence& best, const PoseEvidence& other, const EvidenceOptions& evidence) {
+  for (const double factor : {evidence.points_weight_range, 1.0 / evidence.points_weight_range}) {
+    EvidenceOptions weighed = evidence;
+    weighed.points_weight *= factor;
+    if (!compare_shape(best, other, weighed).decisive) return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 std::string to_string(FrontBackCue cue) {
@@ -103,7 +114,8 @@ Selection select_pose(const std::vector<PoseCandidate>& candidates, const std::v
       continue;
     }
     if (!s.runner_up) s.runner_up = versus;
-    if (!versus.decisive) s.rivals.push_back(order[k]);
+    if (!versus.decisive || !ruled_out_at_every_weight(candidates[s.best].evidence, c.evidence, evidence))
+      s.rivals.push_back(order[k]);
   }
   // Front and back: the mast where it stands clearly behind one of the two, else the side units.
   const Iso3& T = candidates[s.best].T_board_antenna;

@@ -15,11 +15,15 @@
 namespace antpose::registration {
 namespace {
 
+constexpr const char* kPointsStrategy = "points' global start";
+constexpr const char* kHeldStrategy = "as the points place it";
+
 struct Refined {
   PoseCandidate candidate;
   SilhouetteResult outline;
   std::shared_ptr<const model::AntennaModel> model;  // refined with: the panel's shape fitted, where it was
   std::optional<ShapeFit> panel_shape;
+  bool held = false;  // kept where the points placed it (refine_all), its outline not descended
 };
 
 // Whether two poses put the box in one place: orientations within `max_deg` of each other, the box's
@@ -68,14 +72,14 @@ std::vector<PoseCandidate> from_points(const model::AntennaModel& model, const A
   const auto model_cloud = prepare(model::sample_surface(model.mesh_antenna, o.evidence.model_spacing_m, 1), g.fine);
   const auto cloud = prepare(s.points_board, g.fine);
   const auto start = global_align(cloud, model_cloud, s.up_board, g);
-  std::vector<PoseCandidate> out{{start.fit.T_target_source.inverse(), "points' global start", {}, 0.0, nullptr}};
+  std::vector<PoseCandidate> out{{start.fit.T_target_source.inverse(), kPointsStrategy, {}, 0.0, nullptr}};
   for (const auto& h : start.hypotheses) {
     if (out.size() >= o.refine_candidates) break;
     const Iso3 T = h.T_model_scene.inverse();
     const bool apart = std::all_of(out.begin(), out.end(), [&](const PoseCandidate& c) {
       return boresight_angle(c.T_board_antenna.linear(), T.linear()) > deg2rad(o.selection.rival_min_deg);
     });
-    if (apart) out.push_back({T, "points' global start", {}, h.score(), nullptr});
+    if (apart) out.push_back({T, kPointsStrategy, {}, h.score(), nullptr});
   }
   return out;
 }
@@ -91,7 +95,8 @@ SilhouetteOptions polish_of(const SilhouetteOptions& descent) {
 // Each proposal descended by its outline (silhouette.hpp) with the model's box as the outline,
 // twice: through the pyramid from the coarse levels' wide search, and polished at full resolution
 // alone (±fine_search_px), which keeps a narrow panel in its own basin where the coarse levels
-// blur its edges into its neighbours'.
+// blur its edges into its neighbours'. The points' starts are also kept as they lie
+// (RegisterOptions::hold_points_poses), their outline measured there without a descent.
 std::vector<Refined> refine_all(const std::shared_ptr<const model::AntennaModel>& shared, const AntennaScene& s,
                                 const std::vector<PoseCandidate>& proposals, const RegisterOptions& o) {
   std::vector<Refined> out;
@@ -103,11 +108,20 @@ std::vector<Refined> refine_all(const std::shared_ptr<const model::AntennaModel>
     auto descent = o.refine;
     descent.outline_box_m = model::outline_box(*with);
     auto polish = polish_of(descent);
-    for (const SilhouetteOptions* options : {&descent, &polish}) {
+    auto hold = polish;
+    hold.max_iterations_per_level = 0;
+    // A pose the points placed is kept there, and in a later registration stays there.
+    const bool placed_by_points = proposal.strategy == kPointsStrategy || proposal.strategy == kHeldStrategy;
+    const bool hold_it = o.hold_points_poses && placed_by_points;
+    const bool only_hold = hold_it && proposal.strategy == kHeldStrategy;
+    for (const SilhouetteOptions* options : {&descent, &polish, &hold}) {
+      if ((options == &hold && !hold_it) || (options != &hold && only_hold)) continue;
       Refined& r = out.emplace_back();
+      r.held = options == &hold;
       r.outline = refine_by_silhouette(with->mesh_antenna, proposal.T_board_antenna, s.views, s.intrinsics, *options);
       r.candidate = proposal;
       r.candidate.T_board_antenna = r.outline.T_board_antenna;
+      if (r.held) r.candidate.strategy = kHeldStrategy;
       r.model = with;
       if (proposal.panel_shape) r.panel_shape = *proposal.panel_shape;
     }
@@ -234,6 +248,7 @@ void fit_shapes(std::vector<Refined>& kept, const AntennaScene& s, const Registe
   std::vector<bool> carried(n, false);
   for (std::size_t i = 0; i < n; ++i) {
     auto& k = kept[i];
+    if (k.held) continue;
     if (k.panel_shape && same(k.candidate.T_board_antenna, k.panel_shape->outline.T_board_antenna)) {
       k.panel_shape->outline = k.outline;
       carried[i] = true;

@@ -6,7 +6,8 @@
 //                                                  by the outline at its own orientation; the
 //                                                  best ones slid along it (axis_slide.hpp); each
 //                                                  refined too; the best ones' shape (edges, end
-//                                                  caps) profiled with their pose (shape_fit.hpp)
+//                                                  caps) profiled with their pose (shape_fit.hpp);
+//                                                  the points' starts also kept as they lie
 //                                                         │
 //                                    evidence of each and of each turned round (pose_evidence.hpp)
 //                                                         │
@@ -64,6 +65,10 @@ struct RegisterOptions {
   YawTurnOptions turns;               // the best refined candidates turned about their long axis (yaw_turns.hpp)
   bool place_turns = true;            // each turned start also placed by the outline at its own orientation
   AxisSlideOptions slide;             // the best refined candidates slid along their long axis (axis_slide.hpp)
+  /// The points' starts also kept where the points place them, their outline not descended:
+  /// where a faint stretch of the true outline lets the descent lay it on a crease, the descent
+  /// leaves the pose the points hold, and the selection could never weigh it.
+  bool hold_points_poses = true;
   /// The refinement: no restarts of its own (the strategies span the yaws), a trust region on the
   /// rotation, and a neighbour or the mast may hide part of the outline.
   SilhouetteOptions refine = [] {
