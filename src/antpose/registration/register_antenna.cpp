@@ -23,7 +23,8 @@ struct Refined {
   SilhouetteResult outline;
   std::shared_ptr<const model::AntennaModel> model;  // refined with: the panel's shape fitted, where it was
   std::optional<ShapeFit> panel_shape;
-  bool held = false;  // kept where the points placed it (refine_all), its outline not descended
+  // Kept where the points placed it (refine_all), its outline not descended.
+  bool held() const { return candidate.strategy == kHeldStrategy; }
 };
 
 // Whether two poses put the box in one place: orientations within `max_deg` of each other, the box's
@@ -111,17 +112,17 @@ std::vector<Refined> refine_all(const std::shared_ptr<const model::AntennaModel>
     auto hold = polish;
     hold.max_iterations_per_level = 0;
     // A pose the points placed is kept there, and in a later registration stays there.
-    const bool placed_by_points = proposal.strategy == kPointsStrategy || proposal.strategy == kHeldStrategy;
-    const bool hold_it = o.hold_points_poses && placed_by_points;
-    const bool only_hold = hold_it && proposal.strategy == kHeldStrategy;
-    for (const SilhouetteOptions* options : {&descent, &polish, &hold}) {
-      if ((options == &hold && !hold_it) || (options != &hold && only_hold)) continue;
+    const bool was_held = proposal.strategy == kHeldStrategy;
+    const bool hold_it = o.hold_points_poses && (was_held || proposal.strategy == kPointsStrategy);
+    std::vector<const SilhouetteOptions*> runs;
+    if (!(hold_it && was_held)) runs = {&descent, &polish};
+    if (hold_it) runs.push_back(&hold);
+    for (const SilhouetteOptions* options : runs) {
       Refined& r = out.emplace_back();
-      r.held = options == &hold;
       r.outline = refine_by_silhouette(with->mesh_antenna, proposal.T_board_antenna, s.views, s.intrinsics, *options);
       r.candidate = proposal;
       r.candidate.T_board_antenna = r.outline.T_board_antenna;
-      if (r.held) r.candidate.strategy = kHeldStrategy;
+      if (options == &hold) r.candidate.strategy = kHeldStrategy;
       r.model = with;
       if (proposal.panel_shape) r.panel_shape = *proposal.panel_shape;
     }
@@ -248,7 +249,7 @@ void fit_shapes(std::vector<Refined>& kept, const AntennaScene& s, const Registe
   std::vector<bool> carried(n, false);
   for (std::size_t i = 0; i < n; ++i) {
     auto& k = kept[i];
-    if (k.held) continue;
+    if (k.held()) continue;
     if (k.panel_shape && same(k.candidate.T_board_antenna, k.panel_shape->outline.T_board_antenna)) {
       k.panel_shape->outline = k.outline;
       carried[i] = true;
