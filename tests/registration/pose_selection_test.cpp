@@ -79,7 +79,8 @@ TEST(PoseSelection, ANearPoseThatMeetsItsEdgesBetterIsANearRival) {
 // A pose further off whose outline costs more in every photo (a stretch of it too faint to meet an
 // edge) but that the region's points fit much better: the winner's lower score rests on the weight
 // of the points against the outline, which is known only within a range, and at its end the pose
-// is not ruled out: a rival. One the points fit only a little better is ruled out at every weight.
+// is not ruled out: a rival. One the points fit a little better is ruled out: it stays second at
+// every weight.
 TEST(PoseSelection, AnotherYawThePointsFitMuchBetterIsARival) {
   auto with_points = [](PoseCandidate c, std::vector<double> points) {
     c.evidence.points = std::move(points);
@@ -100,6 +101,28 @@ TEST(PoseSelection, AnotherYawThePointsFitMuchBetterIsARival) {
   EvidenceOptions exact;  // with the weight taken as known, the score rules both out
   exact.points_weight_range = 1.0;
   EXPECT_TRUE(select_pose(candidates, twins, std::nullopt, exact, {}).rivals.empty());
+}
+
+// A pose further off that both halves fit worse, the points unevenly: with the points weighed at
+// the top of their range, their scatter swamps the margin, which is then no longer decisive. The
+// winner still ranks first at every weight, and the margin is real at the nominal one: no rival.
+TEST(PoseSelection, AMarginThePointsScatterAtTheEndOfTheRangeStillRulesOut) {
+  auto with_points = [](PoseCandidate c, std::vector<double> points) {
+    c.evidence.points = std::move(points);
+    c.score = c.evidence.score({});
+    return c;
+  };
+  const std::vector<PoseCandidate> candidates{
+      with_points(facing(40, Vec3::Zero(), {0.28, 0.26, 0.27, 0.29, 0.25, 0.27}), {0.30, 0.32, 0.31, 0.29}),
+      with_points(facing(90, Vec3::Zero(), {0.64, 0.60, 0.66, 0.62, 0.63, 0.61}), {0.35, 0.90, 0.30, 0.80})};
+  const std::vector<PoseEvidence> twins(candidates.size(), side({0.0, 0.0}));
+  EvidenceOptions points_heavy;
+  points_heavy.points_weight *= points_heavy.points_weight_range;
+  ASSERT_TRUE(compare_shape(candidates[0].evidence, candidates[1].evidence, {}).decisive);
+  ASSERT_FALSE(compare_shape(candidates[0].evidence, candidates[1].evidence, points_heavy).decisive);
+  const Selection s = select_pose(candidates, twins, std::nullopt, {}, {});
+  EXPECT_EQ(s.best, 0u);
+  EXPECT_TRUE(s.rivals.empty());
 }
 
 TEST(PoseSelection, AMastBehindDecidesFrontAndBackWhateverTheDowntilt) {

@@ -59,8 +59,8 @@ struct EvidenceOptions {
   double points_weight = 1.0;
   // The points' weight against the outline is known only within this factor either way: each
   // half's errors common to all its units (a crease taken for a faint outline, a mount's points
-  // taken for the panel's) escape the units' scatter. A rival the score at either end of that
-  // range does not rule out decisively stays a rival (pose_selection.hpp).
+  // taken for the panel's) escape the units' scatter. A candidate that ranks first at either end of
+  // that range stays a rival (pose_selection.hpp).
   double points_weight_range = 4.0;
   double model_spacing_m = 0.01;  // the model's surface samples
   // The mount's slabs before and behind the panel (antenna frame): from a gap beyond the face

@@ -31,13 +31,16 @@ bool placement_leans_to(const PoseEvidence& other, const PoseEvidence& best, con
   return c.units > 1 && c.difference < -c.standard_error;
 }
 
-// Whether `best` beats `other` decisively with the points weighed against the outline at each end
-// of the range the score's weight is known within (EvidenceOptions::points_weight_range).
-bool ruled_out_at_every_weight(const PoseEvidence& best, const PoseEvidence& other, const EvidenceOptions& evidence) {
+// Whether `best` still ranks above `other`, by more than min_difference, with the points weighed
+// against the outline at each end of the range the score's weight is known within
+// (EvidenceOptions::points_weight_range). The weight is a systematic unknown, not noise: the
+// units' scatter at the nominal weight decides whether a margin is real, and the ends of the range
+// only whether the ranking holds.
+bool ranks_first_at_every_weight(const PoseEvidence& best, const PoseEvidence& other, const EvidenceOptions& evidence) {
   for (const double factor : {evidence.points_weight_range, 1.0 / evidence.points_weight_range}) {
     EvidenceOptions weighed = evidence;
     weighed.points_weight *= factor;
-    if (!compare_shape(best, other, weighed).decisive) return false;
+    if (compare_shape(best, other, weighed).difference <= evidence.min_difference) return false;
   }
   return true;
 }
@@ -114,7 +117,7 @@ Selection select_pose(const std::vector<PoseCandidate>& candidates, const std::v
       continue;
     }
     if (!s.runner_up) s.runner_up = versus;
-    if (!versus.decisive || !ruled_out_at_every_weight(candidates[s.best].evidence, c.evidence, evidence))
+    if (!versus.decisive || !ranks_first_at_every_weight(candidates[s.best].evidence, c.evidence, evidence))
       s.rivals.push_back(order[k]);
   }
   // Front and back: the mast where it stands clearly behind one of the two, else the side units.

@@ -9,11 +9,13 @@
 // lies better on the edges it meets than the winner's, by more than that comparison's standard
 // error (pose_evidence.hpp: where part of the true outline is too faint to be seen, a pose laying
 // its outline on a crease meets more edges and scores lower in every photo alike). A candidate
-// further off is also a rival where the winner does not beat it decisively with the points
-// weighed against the outline at either end of the range that weight is known within
-// (EvidenceOptions::points_weight_range): the crease error above, or a mount's points taken for
-// the panel's, is common to every unit of one half and escapes the comparison's noise, so where
-// the two halves point to different poses, only a margin that holds at every weight rules one out.
+// further off is also a rival, however decisively the winner beats it at the nominal weight, where
+// it ranks first with the points weighed against the outline at either end of the range that
+// weight is known within (EvidenceOptions::points_weight_range): the crease error above, or a
+// mount's points taken for the panel's, is common to every unit of one half and escapes the
+// comparison's noise, so where the two halves point to different poses, the winner must stay first
+// at every weight. The noise test stays at the nominal weight: at the ends of the range one half's
+// scatter swamps the other's, and a margin that is real would read as noise there.
 // Then front and back, which the box's outline cannot tell: the winner against its twin turned
 // by 180° about its long axis. A known mast decides first where it stands clearly behind one of
 // them (a panel's back plate faces its mount); otherwise the side units (the vertical structure
