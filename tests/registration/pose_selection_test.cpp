@@ -14,6 +14,13 @@ PoseCandidate facing(double azimuth_deg, const Vec3& p, std::vector<double> outl
   return c;
 }
 
+// The candidate with the region's points' costs, slice by slice, too.
+PoseCandidate with_points(PoseCandidate c, std::vector<double> points) {
+  c.evidence.points = std::move(points);
+  c.score = c.evidence.score({});
+  return c;
+}
+
 // Side units: the outline cost of the vertical structure behind the pose, photo by photo.
 PoseEvidence side(std::vector<double> mount_outline) {
   PoseEvidence e;
@@ -82,11 +89,6 @@ TEST(PoseSelection, ANearPoseThatMeetsItsEdgesBetterIsANearRival) {
 // is not ruled out: a rival. One the points fit a little better is ruled out: it stays second at
 // every weight.
 TEST(PoseSelection, AnotherYawThePointsFitMuchBetterIsARival) {
-  auto with_points = [](PoseCandidate c, std::vector<double> points) {
-    c.evidence.points = std::move(points);
-    c.score = c.evidence.score({});
-    return c;
-  };
   const std::vector<PoseCandidate> candidates{
       with_points(facing(40, Vec3::Zero(), {0.28, 0.26, 0.27, 0.29, 0.25, 0.27}), {0.55, 0.52, 0.58, 0.54}),
       with_points(facing(65, Vec3::Zero(), {0.64, 0.60, 0.66, 0.62, 0.63, 0.61}), {0.38, 0.36, 0.40, 0.37}),
@@ -107,11 +109,6 @@ TEST(PoseSelection, AnotherYawThePointsFitMuchBetterIsARival) {
 // the top of their range, their scatter swamps the margin, which is then no longer decisive. The
 // winner still ranks first at every weight, and the margin is real at the nominal one: no rival.
 TEST(PoseSelection, AMarginThePointsScatterAtTheEndOfTheRangeStillRulesOut) {
-  auto with_points = [](PoseCandidate c, std::vector<double> points) {
-    c.evidence.points = std::move(points);
-    c.score = c.evidence.score({});
-    return c;
-  };
   const std::vector<PoseCandidate> candidates{
       with_points(facing(40, Vec3::Zero(), {0.28, 0.26, 0.27, 0.29, 0.25, 0.27}), {0.30, 0.32, 0.31, 0.29}),
       with_points(facing(90, Vec3::Zero(), {0.64, 0.60, 0.66, 0.62, 0.63, 0.61}), {0.35, 0.90, 0.30, 0.80})};

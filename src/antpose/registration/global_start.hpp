@@ -32,33 +32,27 @@
 
 namespace antpose::registration {
 
+/// Point-to-plane ICP options for one stage of the global start.
+inline IcpOptions point_to_plane(double max_correspondence_distance_m, int max_iterations,
+                                 double transformation_epsilon) {
+  IcpOptions o;
+  o.method = IcpMethod::kPointToPlane;
+  o.max_correspondence_distance_m = max_correspondence_distance_m;
+  o.max_iterations = max_iterations;
+  o.transformation_epsilon = transformation_epsilon;
+  return o;
+}
+
 struct GlobalStartOptions {
   double yaw_step_deg = 15.0;
   double basin_voxel_m = 0.04;   // the first stage's resolution (file comment)
   double coarse_voxel_m = 0.02;  // hypothesis search resolution
   std::vector<double> downtilt_deg = {0.0, 10.0};
   bool split_starts = true;  // centres at the two halves' centroids too (see the file comment)
-  IcpOptions basin = [] {
-    IcpOptions o;
-    o.method = IcpMethod::kPointToPlane;
-    o.max_correspondence_distance_m = 0.15;
-    o.max_iterations = 30;
-    o.transformation_epsilon = 1e-5;  // 0.26°, 3 mm
-    return o;
-  }();
-  IcpOptions coarse = [] {
-    IcpOptions o;
-    o.method = IcpMethod::kPointToPlane;
-    o.max_correspondence_distance_m = 0.04;
-    o.max_iterations = 30;
-    o.transformation_epsilon = 1e-7;
-    return o;
-  }();
+  IcpOptions basin = point_to_plane(0.15, 30, 1e-5);   // ε: 0.26°, 3 mm
+  IcpOptions coarse = point_to_plane(0.04, 30, 1e-7);
   IcpOptions fine = [] {
-    IcpOptions o;
-    o.method = IcpMethod::kPointToPlane;
-    o.max_correspondence_distance_m = 0.03;
-    o.max_iterations = 50;
+    IcpOptions o = point_to_plane(0.03, 50, IcpOptions{}.transformation_epsilon);
     o.kernel = RobustKernel::kHuber;
     o.kernel_scale = 0.005;
     return o;
