@@ -142,10 +142,10 @@ GlobalStartResult global_align(const PreparedCloud& scene, const PreparedCloud& 
     throw std::invalid_argument("global_align: empty hypothesis grid");
   const Mat3 R_scene_upright = rotation_to_up(up_scene.normalized());
   const Vec3 c_model = centroid(model.cloud.points);
-  const PreparedCloud scene_basin = prepare(voxel_downsample(scene.cloud, o.basin_voxel_m), o.basin);
-  const PreparedCloud model_basin = prepare(voxel_downsample(model.cloud, o.basin_voxel_m), o.basin);
   const PreparedCloud scene_coarse = prepare(voxel_downsample(scene.cloud, o.coarse_voxel_m), o.coarse);
   const PreparedCloud model_coarse = prepare(voxel_downsample(model.cloud, o.coarse_voxel_m), o.coarse);
+  IcpOptions medium = o.coarse;
+  medium.max_correspondence_distance_m = std::max(o.fine.max_correspondence_distance_m, 2.0 * o.coarse_voxel_m);
 
   std::vector<Hypothesis> hypotheses;
   const int yaws = static_cast<int>(std::ceil(360.0 / o.yaw_step_deg - 1e-9));
@@ -168,8 +168,8 @@ GlobalStartResult global_align(const PreparedCloud& scene, const PreparedCloud& 
     Iso3 T_model_scene = Iso3::Identity();
     T_model_scene.linear() = R_scene_model.transpose();
     T_model_scene.translation() = c_model - R_scene_model.transpose() * h.centre_start_scene;
-    T_model_scene = align(scene_basin, model_basin, T_model_scene, o.basin).T_target_source;
-    h.T_model_scene = align(scene_coarse, model_coarse, T_model_scene, o.coarse).T_target_source;
+    T_model_scene = align(scene_coarse, model_coarse, T_model_scene, o.coarse).T_target_source;
+    h.T_model_scene = align(scene_coarse, model_coarse, T_model_scene, medium).T_target_source;
     std::tie(h.residual, h.unseen) = score(scene_coarse, model_coarse, h.T_model_scene, o);
   });
   std::sort(hypotheses.begin(), hypotheses.end(),

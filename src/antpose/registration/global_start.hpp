@@ -5,14 +5,10 @@
 // on a yaw grid; its centre is put at the scene's centroid and, with `split_starts`, at the
 // centroids of the scene's two halves split there across its largest horizontal spread: a region
 // holding a mast beside the panel (a rooftop pipe 0.4 m away with as many points as the radome)
-// can put the centroid between the two, beyond ICP's reach of either. Each hypothesis is
+// puts the centroid between the two, beyond the coarse ICP's reach of either. Each hypothesis is
 // refined by ICP on voxel-downsampled clouds (scene → model:
-// every scene point has a counterpart on the complete model, not the reverse), coarse to fine:
-// first into its basin on clouds of `basin_voxel_m` with a loose convergence (a start for the next
-// stage, not a result: on a panel's flat face ICP slides for many iterations, and each costs a
-// query per scene point), then to the basin's minimum on clouds of `coarse_voxel_m`, where it is
-// scored; the best one and its best rival facing the other way are then refined on the full
-// clouds.
+// every scene point has a counterpart on the complete model, not the reverse) and scored; the
+// best one and its best rival facing the other way are then refined on the full clouds.
 //
 // Score of a hypothesis (lower is better), two parts:
 //   - residual: mean over scene points of min(d², τ²)/τ², d the distance to the model;
@@ -32,27 +28,24 @@
 
 namespace antpose::registration {
 
-/// Point-to-plane ICP options for one stage of the global start.
-inline IcpOptions point_to_plane(double max_correspondence_distance_m, int max_iterations,
-                                 double transformation_epsilon) {
-  IcpOptions o;
-  o.method = IcpMethod::kPointToPlane;
-  o.max_correspondence_distance_m = max_correspondence_distance_m;
-  o.max_iterations = max_iterations;
-  o.transformation_epsilon = transformation_epsilon;
-  return o;
-}
-
 struct GlobalStartOptions {
   double yaw_step_deg = 15.0;
-  double basin_voxel_m = 0.04;   // the first stage's resolution (file comment)
   double coarse_voxel_m = 0.02;  // hypothesis search resolution
   std::vector<double> downtilt_deg = {0.0, 10.0};
   bool split_starts = true;  // centres at the two halves' centroids too (see the file comment)
-  IcpOptions basin = point_to_plane(0.15, 30, 1e-5);   // ε: 0.26°, 3 mm
-  IcpOptions coarse = point_to_plane(0.04, 30, 1e-7);
+  IcpOptions coarse = [] {
+    IcpOptions o;
+    o.method = IcpMethod::kPointToPlane;
+    o.max_correspondence_distance_m = 0.15;
+    o.max_iterations = 30;
+    o.transformation_epsilon = 1e-7;
+    return o;
+  }();
   IcpOptions fine = [] {
-    IcpOptions o = point_to_plane(0.03, 50, IcpOptions{}.transformation_epsilon);
+    IcpOptions o;
+    o.method = IcpMethod::kPointToPlane;
+    o.max_correspondence_distance_m = 0.03;
+    o.max_iterations = 50;
     o.kernel = RobustKernel::kHuber;
     o.kernel_scale = 0.005;
     return o;
