@@ -1,5 +1,8 @@
 #include "antpose/registration/pose_selection.hpp"
 
+#include <set>
+#include <string>
+
 #include <gtest/gtest.h>
 
 namespace antpose::registration {
@@ -162,6 +165,16 @@ TEST(PoseSelection, UprightTurnsAnUpsideDownPoseAboutItsBoresight) {
   const Iso3 T = upright(isometry(upside_down, Vec3(1, 2, 3)), up_board);
   EXPECT_LT(rotation_distance(T.linear(), R), 1e-9);
   EXPECT_TRUE(T.translation().isApprox(Vec3(1, 2, 3)));
+}
+
+// Reports name every strategy, each by its own name.
+TEST(PoseSelection, EveryStrategyHasItsOwnName) {
+  const std::set<std::string> names{to_string(Strategy::kGiven),         to_string(Strategy::kOutlineSearch),
+                                    to_string(Strategy::kPointsStart),   to_string(Strategy::kPointsHeld),
+                                    to_string(Strategy::kTurned),        to_string(Strategy::kTurnedAndPlaced),
+                                    to_string(Strategy::kSlid)};
+  EXPECT_EQ(names.size(), 7u);
+  EXPECT_EQ(to_string(Strategy::kOutlineSearch), "outline search");
 }
 
 }  // namespace

@@ -138,7 +138,7 @@ TEST(RegisterAntenna, AStartInAMirrorYawsBasinIsTurnedToThePanel) {
   ASSERT_NE(far, turns.end());
   Iso3 mirror = s.T_board_antenna;
   mirror.linear() = exp_so3(*far * mirror.linear().col(2)) * mirror.linear();
-  const std::vector<PoseCandidate> start{{mirror, "a mirror of the panel", {}, 0.0, nullptr}};
+  const std::vector<PoseCandidate> start{{mirror, Strategy::kGiven, {}, 0.0, nullptr}};
   RegisterOptions without;
   without.turns.of_best = 0;
   const auto stuck = register_antenna(model, scene, without, start);
@@ -149,7 +149,7 @@ TEST(RegisterAntenna, AStartInAMirrorYawsBasinIsTurnedToThePanel) {
   const auto r = register_antenna(model, scene, {}, start);
   ASSERT_TRUE(r.found) << r.why_not;
   EXPECT_LT(rad2deg(rotation_distance(r.T_board_antenna.linear(), s.T_board_antenna.linear())), 1.0);
-  EXPECT_EQ(r.candidates[r.selection.best].strategy, "turned about its long axis");
+  EXPECT_EQ(r.candidates[r.selection.best].strategy, Strategy::kTurned);
 }
 
 // The points' starts are also candidates where the points place them: with the region's points
@@ -164,7 +164,7 @@ TEST(RegisterAntenna, ThePointsPoseIsKeptWhereThePointsPlaceIt) {
   const auto held = [&](const AntennaRegistration& r) {
     double nearest = std::numeric_limits<double>::infinity();
     for (const auto& c : r.candidates)
-      if (c.strategy == "as the points place it" &&
+      if (c.strategy == Strategy::kPointsHeld &&
           rad2deg(rotation_distance(c.T_board_antenna.linear(), s.T_board_antenna.linear())) < 2.0)
         nearest = std::min(nearest, (c.T_board_antenna.translation() - s.T_board_antenna.translation() - shift).norm());
     return nearest;

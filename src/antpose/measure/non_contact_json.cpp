@@ -89,7 +89,7 @@ nlohmann::json antenna_json(const AntennaMeasurement& m) {
   a["fitness"] = ok ? nlohmann::json(m.fitness) : nullptr;
   nlohmann::json poses = nlohmann::json::array();
   for (const auto& c : m.registration_candidates)
-    poses.push_back({{"strategy", c.strategy},
+    poses.push_back({{"strategy", registration::to_string(c.strategy)},
                      {"score", c.score},
                      {"R_board_antenna", io::matrix_rows_json(c.T_board_antenna.linear())},
                      {"p_board_antenna_m",

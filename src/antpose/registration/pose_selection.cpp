@@ -47,6 +47,26 @@ bool ranks_first_at_every_weight(const PoseEvidence& best, const PoseEvidence& o
 
 }  // namespace
 
+std::string to_string(Strategy strategy) {
+  switch (strategy) {
+    case Strategy::kOutlineSearch:
+      return "outline search";
+    case Strategy::kPointsStart:
+      return "points' global start";
+    case Strategy::kPointsHeld:
+      return "as the points place it";
+    case Strategy::kTurned:
+      return "turned about its long axis";
+    case Strategy::kTurnedAndPlaced:
+      return "turned and placed by the outline";
+    case Strategy::kSlid:
+      return "slid along its long axis";
+    case Strategy::kGiven:
+      break;
+  }
+  return "given";
+}
+
 std::string to_string(FrontBackCue cue) {
   switch (cue) {
     case FrontBackCue::kMast:

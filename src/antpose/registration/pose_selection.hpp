@@ -37,10 +37,23 @@
 
 namespace antpose::registration {
 
+/// The strategy that proposed a candidate (register_antenna.hpp). The refinement keeps a pose the
+/// points placed where they placed it (kPointsHeld), also in a later registration.
+enum class Strategy {
+  kGiven,              // passed in by the caller
+  kOutlineSearch,      // outline_search.hpp
+  kPointsStart,        // global_start.hpp
+  kPointsHeld,         // a points' start kept where the points place it, its outline not descended
+  kTurned,             // yaw_turns.hpp
+  kTurnedAndPlaced,    // a turned start placed again by the outline
+  kSlid,               // axis_slide.hpp
+};
+std::string to_string(Strategy strategy);  // as reports name it, e.g. "outline search"
+
 /// One pose of the model with what the evidence says of it.
 struct PoseCandidate {
   Iso3 T_board_antenna = Iso3::Identity();
-  std::string strategy;  // the strategy that proposed it (for reports)
+  Strategy strategy = Strategy::kGiven;
   PoseEvidence evidence;
   double score = 1.0;  // evidence.score
   /// The panel's shape profiled at this pose (shape_fit.hpp), where it was: a later

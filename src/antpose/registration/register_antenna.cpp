@@ -15,16 +15,13 @@
 namespace antpose::registration {
 namespace {
 
-constexpr const char* kPointsStrategy = "points' global start";
-constexpr const char* kHeldStrategy = "as the points place it";
-
 struct Refined {
   PoseCandidate candidate;
   SilhouetteResult outline;
   std::shared_ptr<const model::AntennaModel> model;  // refined with: the panel's shape fitted, where it was
   std::optional<ShapeFit> panel_shape;
   // Kept where the points placed it (refine_all), its outline not descended.
-  bool held() const { return candidate.strategy == kHeldStrategy; }
+  bool held() const { return candidate.strategy == Strategy::kPointsHeld; }
 };
 
 // Whether two poses put the box in one place: orientations within `max_deg` of each other, the box's
@@ -60,7 +57,7 @@ std::vector<PoseCandidate> from_outline(const model::AntennaModel& model, const 
   std::vector<PoseCandidate> out;
   for (const auto& c : search_box_outline(outline_input(model, s, o), s.intrinsics, o.search).candidates) {
     if (out.size() >= o.refine_candidates) break;
-    out.push_back({c.T_board_antenna, "outline search", {}, c.cost, nullptr});
+    out.push_back({c.T_board_antenna, Strategy::kOutlineSearch, {}, c.cost, nullptr});
   }
   return out;
 }
@@ -73,14 +70,14 @@ std::vector<PoseCandidate> from_points(const model::AntennaModel& model, const A
   const auto model_cloud = prepare(model::sample_surface(model.mesh_antenna, o.evidence.model_spacing_m, 1), g.fine);
   const auto cloud = prepare(s.points_board, g.fine);
   const auto start = global_align(cloud, model_cloud, s.up_board, g);
-  std::vector<PoseCandidate> out{{start.fit.T_target_source.inverse(), kPointsStrategy, {}, 0.0, nullptr}};
+  std::vector<PoseCandidate> out{{start.fit.T_target_source.inverse(), Strategy::kPointsStart, {}, 0.0, nullptr}};
   for (const auto& h : start.hypotheses) {
     if (out.size() >= o.refine_candidates) break;
     const Iso3 T = h.T_model_scene.inverse();
     const bool apart = std::all_of(out.begin(), out.end(), [&](const PoseCandidate& c) {
       return boresight_angle(c.T_board_antenna.linear(), T.linear()) > deg2rad(o.selection.rival_min_deg);
     });
-    if (apart) out.push_back({T, kPointsStrategy, {}, h.score(), nullptr});
+    if (apart) out.push_back({T, Strategy::kPointsStart, {}, h.score(), nullptr});
   }
   return out;
 }
@@ -112,8 +109,8 @@ std::vector<Refined> refine_all(const std::shared_ptr<const model::AntennaModel>
     auto hold = polish;
     hold.max_iterations_per_level = 0;
     // A pose the points placed is kept there, and in a later registration stays there.
-    const bool was_held = proposal.strategy == kHeldStrategy;
-    const bool hold_it = o.hold_points_poses && (was_held || proposal.strategy == kPointsStrategy);
+    const bool was_held = proposal.strategy == Strategy::kPointsHeld;
+    const bool hold_it = o.hold_points_poses && (was_held || proposal.strategy == Strategy::kPointsStart);
     std::vector<const SilhouetteOptions*> runs;
     if (!(hold_it && was_held)) runs = {&descent, &polish};
     if (hold_it) runs.push_back(&hold);
@@ -122,7 +119,7 @@ std::vector<Refined> refine_all(const std::shared_ptr<const model::AntennaModel>
       r.outline = refine_by_silhouette(with->mesh_antenna, proposal.T_board_antenna, s.views, s.intrinsics, *options);
       r.candidate = proposal;
       r.candidate.T_board_antenna = r.outline.T_board_antenna;
-      if (options == &hold) r.candidate.strategy = kHeldStrategy;
+      if (options == &hold) r.candidate.strategy = Strategy::kPointsHeld;
       r.model = with;
       if (proposal.panel_shape) r.panel_shape = *proposal.panel_shape;
     }
@@ -166,7 +163,7 @@ std::vector<PoseCandidate> turned_proposals(const std::vector<Refined>& kept, co
           std::any_of(kept.begin(), kept.end(),
                       [&](const Refined& k) { return near(T, k.candidate.T_board_antenna); }) ||
           std::any_of(out.begin(), out.end(), [&](const PoseCandidate& c) { return near(T, c.T_board_antenna); });
-      if (!known) out.push_back({T, "turned about its long axis", {}, 0.0, nullptr});
+      if (!known) out.push_back({T, Strategy::kTurned, {}, 0.0, nullptr});
     }
   }
   return out;
@@ -191,7 +188,7 @@ std::vector<PoseCandidate> placed_turns(const std::vector<PoseCandidate>& turned
       return same_place(c.T_board_antenna, U, o.same_pose_deg, o.same_pose_m);
     });
     if (c.views < o.search.min_views || known) continue;
-    out.push_back({c.T_board_antenna, "turned and placed by the outline", {}, c.cost, nullptr});
+    out.push_back({c.T_board_antenna, Strategy::kTurnedAndPlaced, {}, c.cost, nullptr});
     taken.push_back(c.T_board_antenna);
   }
   return out;
@@ -206,7 +203,7 @@ std::vector<PoseCandidate> slid_proposals(const std::vector<Refined>& kept, cons
     outline.outline_box_m = model::outline_box(*kept[i].model);
     if (const auto T = slide_along_axis(kept[i].model->mesh_antenna, kept[i].candidate.T_board_antenna, s.views,
                                         s.intrinsics, outline, o.slide))
-      out.push_back({*T, "slid along its long axis", {}, 0.0, kept[i].candidate.panel_shape});
+      out.push_back({*T, Strategy::kSlid, {}, 0.0, kept[i].candidate.panel_shape});
   }
   return out;
 }
