@@ -177,5 +177,25 @@ TEST(Mast, FromPointsAloneIsTheCylinderTheyLieOn) {
   EXPECT_FALSE(mast_from_points(points, up, tall));
 }
 
+// On the mast: within the clearance of its surface or inside it, and of its extent along the axis.
+TEST(Mast, HoldsThePointsOnItsSurfaceAndInsideOverItsExtent) {
+  Mast mast;
+  mast.axis_point_board = Vec3(1.0, 2.0, 3.0);
+  mast.up_board = Vec3(0.0, 0.6, 0.8);
+  mast.radius_m = 0.2;
+  mast.low_m = -1.0, mast.high_m = 2.0;
+  const Vec3 out = mast.up_board.unitOrthogonal();
+  const auto at = [&](double from_axis, double along) {
+    return Vec3(mast.axis_point_board + from_axis * out + along * mast.up_board);
+  };
+  EXPECT_TRUE(on_mast(mast, at(0.2, 0.0), 0.03));
+  EXPECT_TRUE(on_mast(mast, at(0.0, 1.5), 0.03));
+  EXPECT_TRUE(on_mast(mast, at(0.225, -1.02), 0.03));
+  EXPECT_FALSE(on_mast(mast, at(0.24, 0.0), 0.03));
+  EXPECT_FALSE(on_mast(mast, at(0.1, 2.05), 0.03));
+  EXPECT_FALSE(on_mast(mast, at(0.1, -1.05), 0.03));
+  EXPECT_TRUE(on_mast(mast, at(0.24, 0.0), 0.05));
+}
+
 }  // namespace
 }  // namespace antpose::reconstruction

@@ -205,6 +205,7 @@ OptionProblems AntennaOptions::Check() const {
   p.require(board_margin_squares >= 0 && board_thickness_m >= 0, "board_margin_squares, board_thickness_m", "≥ 0");
   p.require(mast_clearance_m >= 0 && mast_outline_below_m > 0, "mast_clearance_m, mast_outline_below_m",
             "clearance ≥ 0, stretch > 0");
+  p.require(mast_points_share > 0 && mast_points_share <= 1, "mast_points_share", "in (0, 1]");
   p.require(reach_m > 0, "reach_m", "positive");
   p.require(min_viewing_span_deg >= 0 && warn_viewing_span_deg >= min_viewing_span_deg,
             "min_viewing_span_deg, warn_viewing_span_deg", "0 ≤ refusal ≤ warning");
@@ -242,6 +243,25 @@ reconstruction::RegionReconstruction antenna_region(const CaptureContext& c, std
                                             region_options, progress);
 }
 
+// A second registration with the mast known (registration_scene.hpp) from the first one's
+// candidates, which have their turns among them; where the mast held a share of the region's
+// points (AntennaOptions::mast_points_share), also from fresh starts without them.
+registration::AntennaRegistration register_with_mast(const model::AntennaModel& model, std::size_t points_before,
+                                                     std::vector<registration::PoseCandidate> starts,
+                                                     const AntennaMeasurement& m, const CaptureContext& c,
+                                                     const SceneObjects& objects, const AntennaOptions& o) {
+  const auto scene = registration_scene(*c.poses, c.up_board, m.region, m.region_view, rect_of(m.roi.roi), objects);
+  const double held = 1.0 - static_cast<double>(scene.points_board.size()) / std::max<std::size_t>(1, points_before);
+  auto options = o.registration;
+  if (held >= o.mast_points_share) {
+    const auto fresh = registration::propose_poses(model, scene, options, false);
+    starts.insert(starts.end(), fresh.begin(), fresh.end());
+  } else {
+    options.turns.of_best = 0;
+  }
+  return registration::register_antenna(model, scene, options, starts);
+}
+
 void measure_antenna(AntennaMeasurement& m, const model::AntennaModel* model, const CaptureContext& c,
                      const std::vector<KnownBox>& neighbours, const AntennaOptions& o,
                      const std::vector<registration::PoseCandidate>& previous) {
@@ -271,6 +291,7 @@ void measure_antenna(AntennaMeasurement& m, const model::AntennaModel* model, co
     SceneObjects objects;
     objects.board_box = board_box(c.board_spec, o);
     objects.neighbours = neighbours;
+    objects.mast = m.mast;  // known from an earlier registration of this antenna
     objects.antenna_depth_m = depths_filling(model->size_m, rect_of(m.roi.roi), c.poses->intrinsics);
     auto scene = registration_scene(*c.poses, c.up_board, m.region, m.region_view, rect_of(m.roi.roi), objects);
     auto proposals = registration::propose_poses(*model, scene, o.registration, !previous.empty());
@@ -279,12 +300,10 @@ void measure_antenna(AntennaMeasurement& m, const model::AntennaModel* model, co
     auto again = o.registration;
     again.turns.of_best = 0;
     auto r = registration::register_antenna(*model, scene, previous.empty() ? o.registration : again, proposals);
-    // A mast found beside the pose is known to a second registration of the same candidates.
     if (r.found && o.mast)
       if (auto mast = find_any_mast(m.region.cloud_board, r.T_board_antenna, model->size_m, c, objects, o)) {
         objects.mast = m.mast = std::move(mast);
-        scene = registration_scene(*c.poses, c.up_board, m.region, m.region_view, rect_of(m.roi.roi), objects);
-        auto with_mast = registration::register_antenna(*model, scene, again, r.candidates);
+        auto with_mast = register_with_mast(*model, scene.points_board.size(), r.candidates, m, c, objects, o);
         if (with_mast.found) r = std::move(with_mast);
       }
     if (!r.found) {

@@ -47,10 +47,13 @@ struct AntennaOptions {
   double board_margin_squares = 1.5;
   double board_thickness_m = 0.03;
   /// A mast sought among the region's points off the registered box (reconstruction/mast.hpp) and
-  /// made known to a second registration, over this stretch below the panel.
+  /// made known to a second registration, over this stretch below the panel. Where the mast holds
+  /// at least `mast_points_share` of the region's points, the first registration's starts from the
+  /// points were drawn towards it: the second one also starts afresh from the points without them.
   bool mast = true;
   double mast_clearance_m = 0.03;
   double mast_outline_below_m = 1.5;
+  double mast_points_share = 0.1;
   reconstruction::MastOptions mast_options;
   reconstruction::MastSearchOptions mast_search;  // by its outline, where the points give no mast
   double min_viewing_span_deg = 2.0;              // of the photos' lines of sight to the antenna
@@ -114,7 +117,9 @@ reconstruction::RegionReconstruction antenna_region(const CaptureContext& captur
 
 /// Registers `model` (nullptr: the model-free fit) to the region with `neighbours` known, and
 /// reads the attitude. `previous`: an earlier registration's candidates, judged again beside a new
-/// outline search instead of every strategy. Sets `m.error` where no pose is found.
+/// outline search instead of every strategy; `m.mast`, where set, is known from the start (found
+/// by that registration) and sought again beside the new pose. Sets `m.error` where no pose is
+/// found.
 void measure_antenna(AntennaMeasurement& m, const model::AntennaModel* model, const CaptureContext& capture,
                      const std::vector<KnownBox>& neighbours, const AntennaOptions& options,
                      const std::vector<registration::PoseCandidate>& previous = {});

@@ -95,6 +95,7 @@ void measure_jointly(std::vector<AntennaMeasurement>& antennas, const NonContact
       if (neighbours.empty()) continue;
       AntennaMeasurement again;
       again.roi = antennas[k].roi, again.region = antennas[k].region, again.region_view = antennas[k].region_view;
+      again.mast = antennas[k].mast;
       again.warnings = again.region.warnings;
       report(options, fmt::format("antenna {}: with its neighbours known", k + 1), 0, 1);
       measure_antenna(again, model, context, neighbours, options.antenna, antennas[k].registration_candidates);

@@ -8,7 +8,6 @@
 #include "antpose/model/box_file.hpp"
 
 namespace antpose::measure {
-namespace {}  // namespace
 
 std::vector<cv::Point2f> box_hull(const KnownBox& box, const camera::CameraIntrinsics& K, const Mat3& R_cb,
                                   const Vec3& t_cb) {
@@ -52,6 +51,13 @@ void add_mast(registration::SilhouetteView& v, const reconstruction::Mast& mast,
 bool near_box(const KnownBox& box, const Vec3& p_board, double clearance) {
   const Vec3 q = box.T_board_box.inverse() * p_board;
   return (q.cwiseAbs().array() <= (box.size_m / 2).array() + clearance).all();
+}
+
+// Whether a region point lies on a known object: a neighbour's box or the mast.
+bool known_object_at(const Vec3& p_board, const SceneObjects& o) {
+  if (o.mast && reconstruction::on_mast(*o.mast, p_board, o.object_clearance_m)) return true;
+  return std::any_of(o.neighbours.begin(), o.neighbours.end(),
+                     [&](const KnownBox& b) { return near_box(b, p_board, o.object_clearance_m); });
 }
 
 // Where the antenna may show in a photo: the region carried there, and the rectangle's frustum
@@ -118,9 +124,7 @@ registration::AntennaScene registration_scene(const CameraPoses& poses, const Ve
   s.roi = roi;
   s.mast = objects.mast;
   for (const Vec3& p : region.cloud_board.points)
-    if (std::none_of(objects.neighbours.begin(), objects.neighbours.end(),
-                     [&](const KnownBox& b) { return near_box(b, p, objects.neighbour_clearance_m); }))
-      s.points_board.points.push_back(p);
+    if (!known_object_at(p, objects)) s.points_board.points.push_back(p);
   const Vec3 centre = s.points_board.empty() ? Vec3::Zero() : Vec3(centroid(s.points_board.points));
   for (std::size_t i = 0; i < poses.views.size(); ++i) {
     const auto& pv = poses.views[i];

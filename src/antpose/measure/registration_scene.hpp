@@ -6,7 +6,8 @@
 // margin hides what lies behind it); a mast found beside the antenna (an occluder in the photos
 // where it stands in front of the antenna, elsewhere its outline is an edge that is not the
 // antenna's); and the capture's other antennas as registered (the same, each by its box). The
-// region's points on a neighbour's box are left out: they are that neighbour's.
+// region's points on a neighbour's box or on the mast are left out: that object explains them,
+// and left in they would draw the model onto it.
 #pragma once
 
 #include <optional>
@@ -31,7 +32,7 @@ struct SceneObjects {
   std::pair<Vec3, Vec3> board_box;  // board frame, min and max corner (printed extent + margin)
   std::optional<reconstruction::Mast> mast;
   std::vector<KnownBox> neighbours;
-  double neighbour_clearance_m = 0.03;  // region points this near a neighbour's box are its own
+  double object_clearance_m = 0.03;  // region points this near a neighbour's box or the mast are its own
   /// Where the antenna may show in a photo: the region carried there, grown by this share of its
   /// larger side (and `area_margin_px`) on every side.
   double area_growth = 0.25;

@@ -100,6 +100,10 @@ std::array<std::vector<cv::Point2f>, 2> mast_outline(const Mast& mast, const cam
 /// The horizontal distance of `p_board` from the mast's surface (m, ≥ 0; inside it too).
 double distance_from_surface(const Mast& mast, const Vec3& p_board);
 
+/// Whether `p_board` lies on the mast or inside it: within `clearance_m` of its surface
+/// (horizontally) and of its extent along the axis.
+bool on_mast(const Mast& mast, const Vec3& p_board, double clearance_m);
+
 /// Whether the mast's axis lies nearer to the camera than `p_board` (horizontal distances): what
 /// lies behind it there is hidden by it.
 bool mast_in_front(const Mast& mast, const Vec3& camera_centre_board, const Vec3& p_board);
