@@ -182,6 +182,24 @@ TEST(RegisterAntenna, ThePointsPoseIsKeptWhereThePointsPlaceIt) {
   EXPECT_FALSE(std::isfinite(held(without)));
 }
 
+// Two panels cannot share volume: with a neighbour known where this panel hangs, no candidate
+// passes through it, and the panel is not found there.
+TEST(RegisterAntenna, NoCandidatePassesThroughAKnownNeighbour) {
+  const SyntheticScene s = make_scene();
+  AntennaScene scene = antenna_scene_with_mast(s);
+  const auto model = model::parametric_panel({});
+  const OrientedBox neighbour{s.T_board_antenna, model.size_m};
+  scene.neighbours_board.push_back(neighbour);
+  const RegisterOptions o;
+  const auto r = register_antenna(model, scene, o);
+  for (const auto& c : r.candidates)
+    EXPECT_FALSE(boxes_overlap({c.T_board_antenna, model.size_m}, neighbour, o.neighbour_clearance_m))
+        << to_string(c.strategy);
+  if (r.found) {
+    EXPECT_GT((r.T_board_antenna.translation() - s.T_board_antenna.translation()).norm(), 0.05);
+  }
+}
+
 // Where no pose meets its outline well, the poses that meet it faintly are measured, with a
 // warning; beyond the faint limit nothing is. The limits are set about this scene's own outline.
 TEST(RegisterAntenna, AnOutlineMetOnlyFaintlyIsMeasuredWithAWarning) {

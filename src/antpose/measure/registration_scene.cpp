@@ -123,6 +123,7 @@ registration::AntennaScene registration_scene(const CameraPoses& poses, const Ve
   s.region_view = region_view;
   s.roi = roi;
   s.mast = objects.mast;
+  for (const auto& b : objects.neighbours) s.neighbours_board.push_back({b.T_board_box, b.size_m});
   for (const Vec3& p : region.cloud_board.points)
     if (!known_object_at(p, objects)) s.points_board.points.push_back(p);
   const Vec3 centre = s.points_board.empty() ? Vec3::Zero() : Vec3(centroid(s.points_board.points));

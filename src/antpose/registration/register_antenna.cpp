@@ -127,10 +127,10 @@ std::vector<Refined> refine_all(const std::shared_ptr<const model::AntennaModel>
   return out;
 }
 
-// Refined candidates that fit the rectangle, one per place: of those ending at the same box pose,
-// the one whose outline fits best, or the best with a profiled shape where one has it (the shape is
-// the panel's; a descent with the model's guessed one is no better evidence of the pose). Best
-// outline first.
+// Refined candidates that fit the rectangle and pass through no known neighbour, one per place: of
+// those ending at the same box pose, the one whose outline fits best, or the best with a profiled
+// shape where one has it (the shape is the panel's; a descent with the model's guessed one is no
+// better evidence of the pose). Best outline first.
 std::vector<Refined> distinct_in_rectangle(std::vector<Refined> refined, const model::AntennaModel& model,
                                            const AntennaScene& s, const RegisterOptions& o) {
   std::sort(refined.begin(), refined.end(),
@@ -140,6 +140,10 @@ std::vector<Refined> distinct_in_rectangle(std::vector<Refined> refined, const m
     const Iso3& T = r.candidate.T_board_antenna;
     const auto [fill, centred] = roi_fill(model.size_m, T, s.views[s.region_view], s.intrinsics, s.roi);
     if (fill < o.min_roi_fill || !centred) continue;
+    const OrientedBox box{T, model.size_m};
+    if (std::any_of(s.neighbours_board.begin(), s.neighbours_board.end(),
+                    [&](const OrientedBox& n) { return boxes_overlap(box, n, o.neighbour_clearance_m); }))
+      continue;
     const auto known = std::find_if(out.begin(), out.end(), [&](const Refined& k) {
       return same_place(T, k.candidate.T_board_antenna, o.same_pose_deg, o.same_pose_m);
     });
@@ -397,6 +401,7 @@ OptionProblems RegisterOptions::Check() const {
   p.nest("mount_search", mount_search.Check());
   p.require(refine_candidates >= 1, "refine_candidates", "at least 1");
   p.require(same_pose_deg >= 0 && same_pose_m >= 0, "same_pose_deg, same_pose_m", "≥ 0");
+  p.require(neighbour_clearance_m >= 0, "neighbour_clearance_m", "≥ 0");
   p.require(min_roi_fill >= 0 && min_roi_fill <= 1, "min_roi_fill", "in [0, 1]");
   p.require(max_outline_score > 0 && max_outline_score <= max_faint_outline_score && max_faint_outline_score <= 1,
             "max_outline_score, max_faint_outline_score", "0 < max_outline_score ≤ max_faint_outline_score ≤ 1");

@@ -15,12 +15,13 @@
 //
 // A candidate must fit the user's rectangle: its box, projected into the rectangle's photo, covers
 // at least `min_roi_fill` of it and has its centre inside it (the rectangle was drawn around this
-// antenna, so a pose on a neighbour or the mast does not qualify); and its outline must meet the
-// photos' edges at least faintly (max_faint_outline_score, min_outline_views). Among those, only the
-// comparison with the best (pose_selection.hpp) rules a candidate out: a fixed score cut would drop
-// the true pose wherever the edges are faint or cluttered and a wrong pose meets other edges a
-// little better, leaving that wrong pose unique. "Not found" is a value: the result says why and
-// what photo or rectangle would help.
+// antenna, so a pose on a neighbour or the mast does not qualify); its box must not pass through a
+// known neighbour's (neighbour_clearance_m: two panels cannot share volume); and its outline must
+// meet the photos' edges at least faintly (max_faint_outline_score, min_outline_views). Among
+// those, only the comparison with the best (pose_selection.hpp) rules a candidate out: a fixed
+// score cut would drop the true pose wherever the edges are faint or cluttered and a wrong pose
+// meets other edges a little better, leaving that wrong pose unique. "Not found" is a value: the
+// result says why and what photo or rectangle would help.
 #pragma once
 
 #include <cstddef>
@@ -29,6 +30,7 @@
 #include <vector>
 
 #include "antpose/core/check.hpp"
+#include "antpose/geometry/oriented_box.hpp"
 #include "antpose/model/antenna_model.hpp"
 #include "antpose/reconstruction/mast.hpp"
 #include "antpose/reconstruction/mast_search.hpp"
@@ -54,6 +56,7 @@ struct AntennaScene {
   cv::Rect roi;                                // the rectangle (px)
   std::vector<std::optional<cv::Rect>> areas;  // per view, where the antenna may show (px)
   std::optional<reconstruction::Mast> mast;    // a mast known beside it
+  std::vector<OrientedBox> neighbours_board;   // the capture's other antennas as registered
 };
 
 struct RegisterOptions {
@@ -69,6 +72,9 @@ struct RegisterOptions {
   /// where a faint stretch of the true outline lets the descent lay it on a crease, the descent
   /// leaves the pose the points hold, and the selection could never weigh it.
   bool hold_points_poses = true;
+  /// A candidate whose box, and a neighbour's, each shrunk by this on every face, still meet passes
+  /// through that neighbour: no panel hangs there (the neighbour's own pose is known to a few cm).
+  double neighbour_clearance_m = 0.05;
   /// The refinement: no restarts of its own (the strategies span the yaws), a trust region on the
   /// rotation, and a neighbour or the mast may hide part of the outline.
   SilhouetteOptions refine = [] {
