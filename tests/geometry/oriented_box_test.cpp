@@ -21,8 +21,8 @@ OrientedBox panel(const Vec3& centre, double yaw_deg, double tilt_deg = 0.0) {
 TEST(OrientedBox, SideBySidePanelsOverlapOnlyWhenTheyShareVolume) {
   EXPECT_FALSE(boxes_overlap(panel(Vec3::Zero(), 0), panel(Vec3(0.5, 0, 0), 0)));
   EXPECT_TRUE(boxes_overlap(panel(Vec3::Zero(), 0), panel(Vec3(0.3, 0, 0), 0)));
-  EXPECT_TRUE(boxes_overlap(panel(Vec3::Zero(), 0), panel(Vec3(0.3, 0, 0), 0), 0.04));
-  EXPECT_FALSE(boxes_overlap(panel(Vec3::Zero(), 0), panel(Vec3(0.3, 0, 0), 0), 0.06));
+  EXPECT_TRUE(boxes_overlap(*shrunk(panel(Vec3::Zero(), 0), 0.04), *shrunk(panel(Vec3(0.3, 0, 0), 0), 0.04)));
+  EXPECT_FALSE(boxes_overlap(*shrunk(panel(Vec3::Zero(), 0), 0.06), *shrunk(panel(Vec3(0.3, 0, 0), 0), 0.06)));
   EXPECT_TRUE(boxes_overlap(panel(Vec3::Zero(), 0), panel(Vec3::Zero(), 30, 10)));
 }
 

@@ -193,7 +193,8 @@ TEST(RegisterAntenna, NoCandidatePassesThroughAKnownNeighbour) {
   const RegisterOptions o;
   const auto r = register_antenna(model, scene, o);
   for (const auto& c : r.candidates)
-    EXPECT_FALSE(boxes_overlap({c.T_board_antenna, model.size_m}, neighbour, o.neighbour_clearance_m))
+    EXPECT_FALSE(boxes_overlap(*shrunk({c.T_board_antenna, model.size_m}, o.neighbour_clearance_m),
+                               *shrunk(neighbour, o.neighbour_clearance_m)))
         << to_string(c.strategy);
   if (r.found) {
     EXPECT_GT((r.T_board_antenna.translation() - s.T_board_antenna.translation()).norm(), 0.05);

@@ -1,5 +1,8 @@
-// A box placed in space (an antenna's, a neighbour's) and whether two of them share volume.
+// A box placed in space (an antenna's, a neighbour's, a simulated mount's) and whether two of
+// them meet.
 #pragma once
+
+#include <optional>
 
 #include "antpose/geometry/point_cloud.hpp"
 
@@ -11,10 +14,12 @@ struct OrientedBox {
   Vec3 size_m = Vec3::Zero();  // edge lengths along the box's x, y, z
 };
 
-/// Whether the two boxes (in one frame), each shrunk by `clearance_m` on every face, intersect:
-/// whether one passes through the other deeper than the clearance. The separating-axis test over
-/// the boxes' 3 + 3 face normals and 9 edge cross products (Gottschalk, Lin & Manocha, "OBBTree",
-/// SIGGRAPH 1996).
-bool boxes_overlap(const OrientedBox& a, const OrientedBox& b, double clearance_m = 0.0);
+/// Whether the two boxes (in one frame) meet, or come within `gap_m` of each other along every
+/// candidate separating axis: the 3 + 3 face normals and the 9 edge cross products (Gottschalk,
+/// Lin & Manocha, "OBBTree", SIGGRAPH 1996).
+bool boxes_overlap(const OrientedBox& a, const OrientedBox& b, double gap_m = 0.0);
+
+/// The box shrunk by `by_m` on every face; nullopt where nothing is left of it.
+std::optional<OrientedBox> shrunk(const OrientedBox& box, double by_m);
 
 }  // namespace antpose

@@ -127,6 +127,16 @@ std::vector<Refined> refine_all(const std::shared_ptr<const model::AntennaModel>
   return out;
 }
 
+// Whether the box and a neighbour's, each shrunk by `clearance_m` on every face, still meet.
+bool passes_through_neighbour(const OrientedBox& box, const std::vector<OrientedBox>& neighbours,
+                              double clearance_m) {
+  const auto core = shrunk(box, clearance_m);
+  return core && std::any_of(neighbours.begin(), neighbours.end(), [&](const OrientedBox& n) {
+           const auto other = shrunk(n, clearance_m);
+           return other && boxes_overlap(*core, *other);
+         });
+}
+
 // Refined candidates that fit the rectangle and pass through no known neighbour, one per place: of
 // those ending at the same box pose, the one whose outline fits best, or the best with a profiled
 // shape where one has it (the shape is the panel's; a descent with the model's guessed one is no
@@ -140,10 +150,7 @@ std::vector<Refined> distinct_in_rectangle(std::vector<Refined> refined, const m
     const Iso3& T = r.candidate.T_board_antenna;
     const auto [fill, centred] = roi_fill(model.size_m, T, s.views[s.region_view], s.intrinsics, s.roi);
     if (fill < o.min_roi_fill || !centred) continue;
-    const OrientedBox box{T, model.size_m};
-    if (std::any_of(s.neighbours_board.begin(), s.neighbours_board.end(),
-                    [&](const OrientedBox& n) { return boxes_overlap(box, n, o.neighbour_clearance_m); }))
-      continue;
+    if (passes_through_neighbour({T, model.size_m}, s.neighbours_board, o.neighbour_clearance_m)) continue;
     const auto known = std::find_if(out.begin(), out.end(), [&](const Refined& k) {
       return same_place(T, k.candidate.T_board_antenna, o.same_pose_deg, o.same_pose_m);
     });

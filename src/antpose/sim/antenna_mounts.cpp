@@ -56,21 +56,10 @@ double distance_to_vertical_axis(const OrientedBox& box, const Vec2& axis_xy) {
 }  // namespace
 
 bool boxes_intersect(const OrientedBox& a, const OrientedBox& b, double clearance_m) {
-  std::vector<Vec3> axes;
-  for (int i = 0; i < 3; ++i) axes.push_back(a.axes.col(i)), axes.push_back(b.axes.col(i));
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) {
-      const Vec3 c = a.axes.col(i).cross(b.axes.col(j));
-      if (c.norm() > 1e-9) axes.push_back(c.normalized());  // parallel edges: the face axes decide
-    }
-  const Vec3 t = b.centre - a.centre;
-  for (const Vec3& L : axes) {
-    double ra = 0.0, rb = 0.0;
-    for (int i = 0; i < 3; ++i)
-      ra += a.half[i] * std::abs(a.axes.col(i).dot(L)), rb += b.half[i] * std::abs(b.axes.col(i).dot(L));
-    if (std::abs(t.dot(L)) > ra + rb + clearance_m) return false;
-  }
-  return true;
+  const auto placed = [](const OrientedBox& box) {
+    return antpose::OrientedBox{isometry(box.axes, box.centre), 2 * box.half};
+  };
+  return boxes_overlap(placed(a), placed(b), clearance_m);
 }
 
 OrientedBox panel_box(const SimAntenna& a) {

@@ -14,6 +14,7 @@
 
 #include <vector>
 
+#include "antpose/geometry/oriented_box.hpp"
 #include "antpose/sim/antenna_scene.hpp"
 
 namespace antpose::sim {
@@ -25,8 +26,8 @@ struct OrientedBox {
   Vec3 half = Vec3::Zero();
 };
 
-/// Whether two boxes overlap or come closer than `clearance_m` along one of the 15 candidate
-/// separating axes.
+/// Whether two boxes overlap or come closer than `clearance_m` along every one of the 15 candidate
+/// separating axes (antpose::boxes_overlap).
 bool boxes_intersect(const OrientedBox& a, const OrientedBox& b, double clearance_m);
 
 /// The box of a rendered panel: its box, the brackets behind it and the end caps' rim.
