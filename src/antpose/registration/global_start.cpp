@@ -107,6 +107,18 @@ std::pair<double, double> score(const PreparedCloud& scene, const PreparedCloud&
   return {residual, facing ? static_cast<double>(missing) / static_cast<double>(facing) : 0.0};
 }
 
+/// At most `max_points` of the cloud, every n-th (the voxel cloud is in spatial order).
+PointCloud every_nth(const PointCloud& cloud, std::size_t max_points) {
+  if (cloud.size() <= max_points) return cloud;
+  const std::size_t step = (cloud.size() + max_points - 1) / max_points;
+  PointCloud out;
+  for (std::size_t i = 0; i < cloud.size(); i += step) {
+    out.points.push_back(cloud.points[i]);
+    if (cloud.has_normals()) out.normals.push_back(cloud.normals[i]);
+  }
+  return out;
+}
+
 }  // namespace
 
 PointCloud voxel_downsample(const PointCloud& cloud, double voxel_m) {
@@ -140,10 +152,12 @@ GlobalStartResult global_align(const PreparedCloud& scene, const PreparedCloud& 
   if (!(up_scene.norm() > 0.0)) throw std::invalid_argument("global_align: zero up vector");
   if (!(o.yaw_step_deg > 0.0) || o.downtilt_deg.empty())
     throw std::invalid_argument("global_align: empty hypothesis grid");
+  if (o.coarse_max_points < 6) throw std::invalid_argument("global_align: coarse_max_points must be at least 6");
   const Mat3 R_scene_upright = rotation_to_up(up_scene.normalized());
   const Vec3 c_model = centroid(model.cloud.points);
   const PreparedCloud scene_coarse = prepare(voxel_downsample(scene.cloud, o.coarse_voxel_m), o.coarse);
   const PreparedCloud model_coarse = prepare(voxel_downsample(model.cloud, o.coarse_voxel_m), o.coarse);
+  const PreparedCloud scene_sparse = prepare(every_nth(scene_coarse.cloud, o.coarse_max_points), o.coarse);
   IcpOptions medium = o.coarse;
   medium.max_correspondence_distance_m = std::max(o.fine.max_correspondence_distance_m, 2.0 * o.coarse_voxel_m);
 
@@ -159,7 +173,8 @@ GlobalStartResult global_align(const PreparedCloud& scene, const PreparedCloud& 
         hypotheses.push_back(h);
       }
   // The hypotheses are independent: refine them in parallel (ICP itself is parallel too; TBB
-  // nests the two without oversubscribing).
+  // nests the two without oversubscribing). The ICPs move the sparse points; the score weighs
+  // them all.
   tbb::parallel_for(std::size_t{0}, hypotheses.size(), [&](std::size_t i) {
     auto& h = hypotheses[i];
     // R_scene_model: upright, turned by yaw about up, tilted down about the model's x axis.
@@ -168,8 +183,8 @@ GlobalStartResult global_align(const PreparedCloud& scene, const PreparedCloud& 
     Iso3 T_model_scene = Iso3::Identity();
     T_model_scene.linear() = R_scene_model.transpose();
     T_model_scene.translation() = c_model - R_scene_model.transpose() * h.centre_start_scene;
-    T_model_scene = align(scene_coarse, model_coarse, T_model_scene, o.coarse).T_target_source;
-    h.T_model_scene = align(scene_coarse, model_coarse, T_model_scene, medium).T_target_source;
+    T_model_scene = align(scene_sparse, model_coarse, T_model_scene, o.coarse).T_target_source;
+    h.T_model_scene = align(scene_sparse, model_coarse, T_model_scene, medium).T_target_source;
     std::tie(h.residual, h.unseen) = score(scene_coarse, model_coarse, h.T_model_scene, o);
   });
   std::sort(hypotheses.begin(), hypotheses.end(),

@@ -31,6 +31,10 @@ namespace antpose::registration {
 struct GlobalStartOptions {
   double yaw_step_deg = 15.0;
   double coarse_voxel_m = 0.02;  // hypothesis search resolution
+  // The ICPs of every start move at most this many of the scene's voxel points, spread evenly
+  // (Rusinkiewicz & Levoy 2001: sampling the source costs ICP little of its reach); the score
+  // weighs them all.
+  std::size_t coarse_max_points = 2000;
   std::vector<double> downtilt_deg = {0.0, 10.0};
   bool split_starts = true;  // centres at the two halves' centroids too (see the file comment)
   IcpOptions coarse = [] {
@@ -57,7 +61,7 @@ struct GlobalStartOptions {
 
 struct Hypothesis {
   double yaw_rad = 0.0, downtilt_rad = 0.0;  // of the start
-  Vec3 centre_start_scene = Vec3::Zero();     // where the model's centre started
+  Vec3 centre_start_scene = Vec3::Zero();    // where the model's centre started
   Iso3 T_model_scene = Iso3::Identity();     // after refinement
   double residual = 0.0, unseen = 0.0;       // the two score parts
   double score() const { return residual + unseen; }

@@ -110,7 +110,8 @@ namespace {
 // The model's projection in one photo as a mask (for a closed mesh its front faces alone cover it:
 // every line of sight into the solid enters through one), edges subdivided so that the
 // distortion's bowing is kept; over the projection's own box (so that the outer-contour test also
-// works outside the crop, where samples are counted as unmeasurable), at most ~1000 px. With the
+// works outside the crop, where samples are counted as unmeasurable), at most ~1000 px and no finer
+// than half the pyramid level's pixel (`level_px`, full-resolution px) it is searched at. With the
 // vertices' projections; nullopt where part of the model is behind the camera.
 struct ProjectionMask {
   cv::Mat mask;
@@ -126,7 +127,8 @@ struct ProjectionMask {
 };
 
 std::optional<ProjectionMask> project_model(const EdgeMesh& m, const Pose& pose, const PreparedView& v,
-                                            const camera::CameraIntrinsics& K, const std::vector<char>& front) {
+                                            const camera::CameraIntrinsics& K, const std::vector<char>& front,
+                                            double level_px) {
   ProjectionMask out;
   out.uv.resize(m.vertices.size());
   Vec2 lo = Vec2::Constant(1e300), hi = Vec2::Constant(-1e300);
@@ -139,7 +141,7 @@ std::optional<ProjectionMask> project_model(const EdgeMesh& m, const Pose& pose,
   out.origin = lo - Vec2::Constant(pad);
   const Vec2 extent = hi - lo + Vec2::Constant(2 * pad);
   if (!(extent.maxCoeff() < 1e5)) return std::nullopt;  // a degenerate projection (model at the camera)
-  out.ms = std::max(1.0, extent.maxCoeff() / 1000.0);
+  out.ms = std::max({1.0, extent.maxCoeff() / 1000.0, level_px / 2});
   out.mask = cv::Mat::zeros(static_cast<int>(std::ceil(extent.y() / out.ms)) + 1,
                             static_cast<int>(std::ceil(extent.x() / out.ms)) + 1, CV_8UC1);
   std::vector<cv::Point> poly;
@@ -149,8 +151,13 @@ std::optional<ProjectionMask> project_model(const EdgeMesh& m, const Pose& pose,
     poly.clear();
     for (int k = 0; k < 3; ++k) {
       const Vec3 A = pose.R * m.vertices[t[k]] + pose.t, B = pose.R * m.vertices[t[(k + 1) % 3]] + pose.t;
-      const double len = (*out.uv[t[(k + 1) % 3]] - *out.uv[t[k]]).norm() / out.ms;
-      const int n = std::clamp(static_cast<int>(std::ceil(len / 8.0)), 1, 64);
+      const Vec2 &a = *out.uv[t[k]], &b = *out.uv[t[(k + 1) % 3]];
+      const double len = (b - a).norm() / out.ms;
+      // Subdivided where the distortion bows the side by more than the vertices' quarter pixel.
+      const auto middle = project(K, v, 0.5 * (A + B));
+      if (!middle) return std::nullopt;
+      const bool bowed = (*middle - 0.5 * (a + b)).norm() / out.ms > 0.25;
+      const int n = bowed ? std::clamp(static_cast<int>(std::ceil(len / 8.0)), 1, 64) : 1;
       for (int j = 0; j < n; ++j) {
         const auto p = project(K, v, A + (B - A) * (double(j) / n));
         if (!p) return std::nullopt;
@@ -158,9 +165,8 @@ std::optional<ProjectionMask> project_model(const EdgeMesh& m, const Pose& pose,
         poly.emplace_back(round_px(q.x()), round_px(q.y()));
       }
     }
-    const cv::Point* vertices = poly.data();
-    const int count = static_cast<int>(poly.size());
-    cv::fillPoly(out.mask, &vertices, &count, 1, cv::Scalar(255), cv::LINE_8, 2);
+    // A triangle's projection, its sides bowed by the distortion alone, is monotonic in y.
+    cv::fillConvexPoly(out.mask, poly, cv::Scalar(255), cv::LINE_8, 2);
   }
   return out;
 }
@@ -199,7 +205,7 @@ void gather(const EdgeMesh& m, const Pose& pose, const PreparedView& v, const ca
   std::vector<char> front(m.triangles.size());
   for (std::size_t f = 0; f < m.triangles.size(); ++f)
     front[f] = m.normals[f].dot(centre_antenna - m.vertices[m.triangles[f][0]]) > 0;
-  const auto projection = project_model(m, pose, v, K, front);
+  const auto projection = project_model(m, pose, v, K, front, scale);
   if (!projection) return;
   const ProjectionMask& pm = *projection;
   // The projection's extent behind an outline point (mask px against its outward normal), up to
