@@ -41,7 +41,7 @@ TEST(AntennaAttitude, ARivalWidensEachAngleToHalfItsDifference) {
   EXPECT_NEAR(*m.result.sigma.roll, *before.roll, 1e-9);
 }
 
-// A panel 3.9° down whose rival lies 30° round about the vertical, with the same roll (5610-1):
+// A panel 3.9° down whose rival lies 30° round about the vertical, with the same roll:
 // the truth may lie as far round the panel's own long axis, which turns its roll by about
 // 30° · sin(3.9°) = 2.0°; the roll's σ covers half that.
 TEST(AntennaAttitude, ARivalYawAlsoWidensTheRollAboutTheTiltedAxis) {

@@ -121,7 +121,7 @@ TEST(BundleAdjust, WarnsWhenNoFeaturesTieTheViews) {
 
 // Features that agree with each other but not with the board (each photo's scene shifted as if
 // the camera had turned, the board's corners where they were): the poses rest on the board
-// alone, and the result says why (site 3802: false tracks turned every camera by 0.03–0.10°).
+// alone, and the result says why (false tracks can turn every camera by a tenth of a degree).
 TEST(BundleAdjust, FeaturesThatPullThePosesOffTheBoardAreLeftOut) {
   SceneOptions sharp_board;
   sharp_board.board_noise_px = 0.05;  // corners as sharp as a 12 MP photo's (0.04–0.05 px RMS)
@@ -431,7 +431,7 @@ TEST(ReconstructRegion, BeyondTheFirstObjectLiesTheNext) {
 }
 
 // Where a nearer object in the rectangle gives features but too few points for an antenna (a
-// card 2 m from the camera here; on 6003-2 the board's tripod and then false matches, so two),
+// card 2 m from the camera here; on a site, the board's tripod and then false matches, so two),
 // it is passed, and the next object beyond, up to RegionOptions::max_objects in all: the antenna
 // is reconstructed with a warning that names the depths passed. Allowed only the nearest, the
 // answer is the nearest's error.

@@ -219,6 +219,34 @@ TEST(Silhouette, UsesGivenRegionsOfInterest) {
   EXPECT_FALSE(cut.warnings.empty());
 }
 
+// Runs from one start that differ only in their search share the prepared photos and end exactly
+// where each would alone; runs that would prepare the photos differently are refused.
+TEST(Silhouette, RunsFromOneStartEndAsEachAlone) {
+  const auto& s = scene();
+  const Iso3 start = perturbed(s.T_board_antenna, -4.0, 1.5, Vec3(0.02, -0.02, 0.015));
+  SilhouetteOptions descent;
+  SilhouetteOptions polish = descent;
+  polish.max_level = 0;
+  polish.search_range_px = polish.fine_search_px;
+  SilhouetteOptions held = polish;
+  held.max_iterations_per_level = 0;
+  const std::vector<SilhouetteOptions> runs{descent, polish, held};
+  const auto together = refine_by_silhouette_runs(s.mesh_antenna, start, s.views, s.intrinsics, runs);
+  ASSERT_EQ(together.size(), runs.size());
+  for (std::size_t k = 0; k < runs.size(); ++k) {
+    const auto alone = refine_by_silhouette(s.mesh_antenna, start, s.views, s.intrinsics, runs[k]);
+    EXPECT_EQ(together[k].score, alone.score) << k;
+    EXPECT_EQ(together[k].iterations, alone.iterations) << k;
+    EXPECT_TRUE(together[k].T_board_antenna.isApprox(alone.T_board_antenna, 0.0)) << k;
+    EXPECT_EQ(together[k].converged, alone.converged) << k;
+  }
+  EXPECT_NE(together[0].iterations, together[2].iterations);  // the runs did differ
+  SilhouetteOptions other_gamma = descent;
+  other_gamma.gamma = 1.0;
+  EXPECT_THROW(refine_by_silhouette_runs(s.mesh_antenna, start, s.views, s.intrinsics, {descent, other_gamma}),
+               std::invalid_argument);
+}
+
 TEST(Silhouette, FarStartIsNotAConfidentWrongAnswer) {
   const auto& s = scene();
   const Iso3 start = perturbed(s.T_board_antenna, 40.0, 2.0, Vec3(0.03, -0.03, 0.025));
@@ -302,7 +330,7 @@ TEST(Silhouette, ASwingingDescentHasArrived) {
 // From the ground a narrow panel (the thesis's, 0.16 m wide) 25 m away is 19 px wide in front of
 // a mast three times as wide, photographed over 10° of directions: within the coarse search the
 // mast's strong edges are the nearest, and over so narrow an arc poses many degrees apart in yaw
-// fit the outline about equally (acceptance sites 1102-1, 1402-1: docs/non-contact.md). Whatever
+// fit the outline about equally. Whatever
 // the descent finds, it must not be a confident wrong answer.
 const SyntheticScene& narrow_panel_from_the_ground() {
   static const SyntheticScene s = [] {
@@ -404,8 +432,8 @@ TEST(Silhouette, AKnownMastBehindANarrowPanelLeavesThePanelsOwnOutline) {
 // photo) can only be told from a turn where the views see the panel's width change with yaw in
 // different ways: over 30° from 6 m (the rooftop) it turns the yaw by under a hundredth of a degree;
 // a narrow panel seen face-on from 26 m over 10° must widen by turning, so outline_dilation_px
-// turns it by degrees (5910-2: the outline found 0.13 px wider than the model's at the truth,
-// and the fit settled 3.5° away), and the yaw's σ holds that.
+// turns it by degrees (an outline found 0.13 px wider than the model's can settle the fit 3.5°
+// away), and the yaw's σ holds that.
 TEST(Silhouette, ADilatedOutlineTurnsTheYawOfANarrowPanelSeenFaceOn) {
   SilhouetteOptions options;
   options.rival_yaw_offsets_rad.clear();
@@ -463,8 +491,8 @@ TEST(Silhouette, AMonotoneDescentWithTheAxisHeldKeepsANarrowPanelsOutline) {
 }
 
 // The brackets' outline runs into the arms that hold them, which the model lacks, so it is found
-// a pixel or two off; at the back plate's lever arm that turned a narrow panel's yaw by 4.8°
-// (development site 2902-1, from the truth as the start). With the model's box given, outline
+// a pixel or two off; at the back plate's lever arm that can turn a narrow panel's yaw by
+// degrees, even from the truth as the start. With the model's box given, outline
 // points on the brackets are no samples of the fit; their edge costs go into the whole
 // outline's score, which still tells the back from the front.
 TEST(Silhouette, TheBracketsOutlineTellsTheBackButIsNotFitted) {

@@ -26,8 +26,7 @@ struct Refined {
 
 // Whether two poses put the box in one place: orientations within `max_deg` of each other, the box's
 // half turn about its long axis allowed (box_angle: the same outline), and centres within `max_m`.
-bool same_place(const Iso3& T, const Iso3& U, double max_deg,
-                double max_m = std::numeric_limits<double>::infinity()) {
+bool same_place(const Iso3& T, const Iso3& U, double max_deg, double max_m = std::numeric_limits<double>::infinity()) {
   return rad2deg(box_angle(T.linear(), U.linear())) < max_deg && (T.translation() - U.translation()).norm() < max_m;
 }
 
@@ -111,15 +110,17 @@ std::vector<Refined> refine_all(const std::shared_ptr<const model::AntennaModel>
     // A pose the points placed is kept there, and in a later registration stays there.
     const bool was_held = proposal.strategy == Strategy::kPointsHeld;
     const bool hold_it = o.hold_points_poses && (was_held || proposal.strategy == Strategy::kPointsStart);
-    std::vector<const SilhouetteOptions*> runs;
-    if (!(hold_it && was_held)) runs = {&descent, &polish};
-    if (hold_it) runs.push_back(&hold);
-    for (const SilhouetteOptions* options : runs) {
+    std::vector<SilhouetteOptions> runs;
+    if (!(hold_it && was_held)) runs = {descent, polish};
+    if (hold_it) runs.push_back(hold);
+    auto outlines =
+        refine_by_silhouette_runs(with->mesh_antenna, proposal.T_board_antenna, s.views, s.intrinsics, runs);
+    for (std::size_t k = 0; k < runs.size(); ++k) {
       Refined& r = out.emplace_back();
-      r.outline = refine_by_silhouette(with->mesh_antenna, proposal.T_board_antenna, s.views, s.intrinsics, *options);
+      r.outline = std::move(outlines[k]);
       r.candidate = proposal;
       r.candidate.T_board_antenna = r.outline.T_board_antenna;
-      if (options == &hold) r.candidate.strategy = Strategy::kPointsHeld;
+      if (hold_it && k + 1 == runs.size()) r.candidate.strategy = Strategy::kPointsHeld;
       r.model = with;
       if (proposal.panel_shape) r.panel_shape = *proposal.panel_shape;
     }
@@ -128,8 +129,7 @@ std::vector<Refined> refine_all(const std::shared_ptr<const model::AntennaModel>
 }
 
 // Whether the box and a neighbour's, each shrunk by `clearance_m` on every face, still meet.
-bool passes_through_neighbour(const OrientedBox& box, const std::vector<OrientedBox>& neighbours,
-                              double clearance_m) {
+bool passes_through_neighbour(const OrientedBox& box, const std::vector<OrientedBox>& neighbours, double clearance_m) {
   const auto core = shrunk(box, clearance_m);
   return core && std::any_of(neighbours.begin(), neighbours.end(), [&](const OrientedBox& n) {
            const auto other = shrunk(n, clearance_m);

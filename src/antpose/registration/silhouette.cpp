@@ -304,18 +304,14 @@ bool passes_checks(SilhouetteResult& result, bool solvable, const OutlineCounts&
   return ok;
 }
 
-}  // namespace
-
-SilhouetteResult refine_by_silhouette(const model::Mesh& mesh_antenna, const Iso3& T_board_antenna_initial,
-                                      const std::vector<SilhouetteView>& views,
-                                      const camera::CameraIntrinsics& intrinsics, const SilhouetteOptions& options,
-                                      const std::optional<RotationPrior>& prior) {
-  if (mesh_antenna.triangles.empty()) throw std::invalid_argument("refine_by_silhouette: the mesh has no triangles");
-  const EdgeMesh m = weld(mesh_antenna);
+// One descent from `start` on photos prepared for it (up to at least this run's coarsest level).
+SilhouetteResult refine_prepared(const EdgeMesh& m, const Pose& start, const PreparedViews& prepared,
+                                 const camera::CameraIntrinsics& intrinsics, const SilhouetteOptions& options,
+                                 const std::optional<RotationPrior>& prior) {
   SilhouetteResult result;
-  result.T_board_antenna = T_board_antenna_initial;
-  const Pose start{T_board_antenna_initial.linear(), T_board_antenna_initial.translation()};
-  const PreparedViews ready = prepare_views(m, {start}, views, intrinsics, options, options.max_level, result.warnings);
+  result.T_board_antenna = start.T();
+  PreparedViews ready = prepared;  // shares the images
+  ready.top = std::min(ready.top, std::max(0, options.max_level));
   Descender descender(m, ready, intrinsics, options, prior);
 
   Descent best = descender.descend(start);
@@ -355,6 +351,49 @@ SilhouetteResult refine_by_silhouette(const model::Mesh& mesh_antenna, const Iso
   result.stopped_at_iteration_limit = ok && !best.converged;
   result.converged = ok && best.converged;
   return result;
+}
+
+// Whether two runs prepare their photos alike (prepare_views), but for the coarsest level.
+bool prepared_alike(const SilhouetteOptions& a, const SilhouetteOptions& b) {
+  return a.roi_margin_px == b.roi_margin_px && a.gamma == b.gamma && a.smoothing_sigma_px == b.smoothing_sigma_px &&
+         a.mask_guard_px == b.mask_guard_px && a.min_coarse_width_px == b.min_coarse_width_px;
+}
+
+}  // namespace
+
+std::vector<SilhouetteResult> refine_by_silhouette_runs(const model::Mesh& mesh_antenna,
+                                                        const Iso3& T_board_antenna_initial,
+                                                        const std::vector<SilhouetteView>& views,
+                                                        const camera::CameraIntrinsics& intrinsics,
+                                                        const std::vector<SilhouetteOptions>& runs,
+                                                        const std::optional<RotationPrior>& prior) {
+  if (mesh_antenna.triangles.empty()) throw std::invalid_argument("refine_by_silhouette: the mesh has no triangles");
+  if (runs.empty()) return {};
+  for (const auto& run : runs)
+    if (!prepared_alike(run, runs.front()))
+      throw std::invalid_argument(
+          "refine_by_silhouette_runs: the runs must prepare the photos alike (roi_margin_px, gamma, "
+          "smoothing_sigma_px, "
+          "mask_guard_px, min_coarse_width_px)");
+  const EdgeMesh m = weld(mesh_antenna);
+  const Pose start{T_board_antenna_initial.linear(), T_board_antenna_initial.translation()};
+  int max_level = 0;
+  for (const auto& run : runs) max_level = std::max(max_level, run.max_level);
+  std::vector<std::string> warnings;
+  const PreparedViews ready = prepare_views(m, {start}, views, intrinsics, runs.front(), max_level, warnings);
+  std::vector<SilhouetteResult> out;
+  for (const auto& run : runs) {
+    out.push_back(refine_prepared(m, start, ready, intrinsics, run, prior));
+    out.back().warnings.insert(out.back().warnings.begin(), warnings.begin(), warnings.end());
+  }
+  return out;
+}
+
+SilhouetteResult refine_by_silhouette(const model::Mesh& mesh_antenna, const Iso3& T_board_antenna_initial,
+                                      const std::vector<SilhouetteView>& views,
+                                      const camera::CameraIntrinsics& intrinsics, const SilhouetteOptions& options,
+                                      const std::optional<RotationPrior>& prior) {
+  return refine_by_silhouette_runs(mesh_antenna, T_board_antenna_initial, views, intrinsics, {options}, prior).front();
 }
 
 std::vector<OutlineEvaluation> evaluate_outlines(const model::Mesh& mesh_antenna, const std::vector<Iso3>& poses,

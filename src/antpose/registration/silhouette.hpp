@@ -180,6 +180,18 @@ SilhouetteResult refine_by_silhouette(const model::Mesh& mesh_antenna, const Iso
                                       const camera::CameraIntrinsics& intrinsics, const SilhouetteOptions& options,
                                       const std::optional<RotationPrior>& prior = std::nullopt);
 
+/// The same from one start with each of `runs`, options that differ only in their search
+/// (levels, ranges, iterations, rivals): the photos are cropped and their gradient pyramids made
+/// once, to the coarsest level any run allows. std::invalid_argument also where the runs would
+/// prepare the photos differently (roi_margin_px, gamma, smoothing_sigma_px, mask_guard_px,
+/// min_coarse_width_px).
+std::vector<SilhouetteResult> refine_by_silhouette_runs(const model::Mesh& mesh_antenna,
+                                                        const Iso3& T_board_antenna_initial,
+                                                        const std::vector<SilhouetteView>& views,
+                                                        const camera::CameraIntrinsics& intrinsics,
+                                                        const std::vector<SilhouetteOptions>& runs,
+                                                        const std::optional<RotationPrior>& prior = std::nullopt);
+
 /// The outline's fit at one pose, photo by photo, without a descent: what the registration's
 /// selection compares between poses (registration/pose_evidence.hpp). Costs as
 /// SilhouetteResult::score (the mean truncated edge cost, 0 .. 1) over each photo's samples at
