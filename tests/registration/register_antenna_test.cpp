@@ -184,6 +184,16 @@ TEST(RegisterAntenna, ThePointsPoseIsKeptWhereThePointsPlaceIt) {
 
 // Two panels cannot share volume: with a neighbour known where this panel hangs, no candidate
 // passes through it, and the panel is not found there.
+TEST(RegisterAntenna, AContinuingRegistrationMakesNoTurnsOfItsOwn) {
+  RegisterOptions o;
+  ASSERT_GT(o.turns.of_best, 0u);
+  const auto c = continuing(o);
+  EXPECT_EQ(c.turns.of_best, 0u);
+  EXPECT_EQ(c.slide.of_best, o.slide.of_best);
+  EXPECT_EQ(c.refine_candidates, o.refine_candidates);
+  EXPECT_TRUE(c.Check().ok());
+}
+
 TEST(RegisterAntenna, NoCandidatePassesThroughAKnownNeighbour) {
   const SyntheticScene s = make_scene();
   AntennaScene scene = antenna_scene_with_mast(s);

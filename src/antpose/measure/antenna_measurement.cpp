@@ -252,14 +252,11 @@ registration::AntennaRegistration register_with_mast(const model::AntennaModel& 
                                                      const SceneObjects& objects, const AntennaOptions& o) {
   const auto scene = registration_scene(*c.poses, c.up_board, m.region, m.region_view, rect_of(m.roi.roi), objects);
   const double held = 1.0 - static_cast<double>(scene.points_board.size()) / std::max<std::size_t>(1, points_before);
-  auto options = o.registration;
-  if (held >= o.mast_points_share) {
-    const auto fresh = registration::propose_poses(model, scene, options, false);
-    starts.insert(starts.end(), fresh.begin(), fresh.end());
-  } else {
-    options.turns.of_best = 0;
-  }
-  return registration::register_antenna(model, scene, options, starts);
+  if (held < o.mast_points_share)
+    return registration::register_antenna(model, scene, registration::continuing(o.registration), starts);
+  const auto fresh = registration::propose_poses(model, scene, o.registration, false);
+  starts.insert(starts.end(), fresh.begin(), fresh.end());
+  return registration::register_antenna(model, scene, o.registration, starts);
 }
 
 void measure_antenna(AntennaMeasurement& m, const model::AntennaModel* model, const CaptureContext& c,
@@ -296,10 +293,8 @@ void measure_antenna(AntennaMeasurement& m, const model::AntennaModel* model, co
     auto scene = registration_scene(*c.poses, c.up_board, m.region, m.region_view, rect_of(m.roi.roi), objects);
     auto proposals = registration::propose_poses(*model, scene, o.registration, !previous.empty());
     proposals.insert(proposals.end(), previous.begin(), previous.end());
-    // A registration that starts from an earlier one's candidates has that one's turns among them.
-    auto again = o.registration;
-    again.turns.of_best = 0;
-    auto r = registration::register_antenna(*model, scene, previous.empty() ? o.registration : again, proposals);
+    auto r = registration::register_antenna(
+        *model, scene, previous.empty() ? o.registration : registration::continuing(o.registration), proposals);
     if (r.found && o.mast)
       if (auto mast = find_any_mast(m.region.cloud_board, r.T_board_antenna, model->size_m, c, objects, o)) {
         objects.mast = m.mast = std::move(mast);

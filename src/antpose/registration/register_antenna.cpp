@@ -440,6 +440,11 @@ std::vector<PoseCandidate> propose_poses(const model::AntennaModel& model, const
   return proposals;
 }
 
+RegisterOptions continuing(RegisterOptions options) {
+  options.turns.of_best = 0;
+  return options;
+}
+
 AntennaRegistration register_antenna(const model::AntennaModel& model, const AntennaScene& s,
                                      const RegisterOptions& o) {
   return register_antenna(model, s, o, propose_poses(model, s, o));

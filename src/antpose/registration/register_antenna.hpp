@@ -137,9 +137,13 @@ std::vector<PoseCandidate> propose_poses(const model::AntennaModel& model, const
 /// The proposals refined, judged and selected. A second registration of the same antenna in a
 /// scene that knows more (a mast, neighbours) passes the first one's candidates as proposals;
 /// those with a profiled shape keep it (PoseCandidate::panel_shape). The first registration's
-/// turns are among them: the second needs none of its own (`turns.of_best = 0`).
+/// turns are among them: the second needs none of its own (continuing(options)).
 AntennaRegistration register_antenna(const model::AntennaModel& model, const AntennaScene& scene,
                                      const RegisterOptions& options, const std::vector<PoseCandidate>& proposals);
+
+/// The options of a registration that starts from an earlier one's candidates: those hold the
+/// earlier one's turns, so it makes none of its own (`turns.of_best = 0`).
+RegisterOptions continuing(RegisterOptions options);
 
 /// propose_poses, then the above.
 AntennaRegistration register_antenna(const model::AntennaModel& model, const AntennaScene& scene,
