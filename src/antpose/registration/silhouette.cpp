@@ -373,8 +373,7 @@ std::vector<SilhouetteResult> refine_by_silhouette_runs(const model::Mesh& mesh_
     if (!prepared_alike(run, runs.front()))
       throw std::invalid_argument(
           "refine_by_silhouette_runs: the runs must prepare the photos alike (roi_margin_px, gamma, "
-          "smoothing_sigma_px, "
-          "mask_guard_px, min_coarse_width_px)");
+          "smoothing_sigma_px, mask_guard_px, min_coarse_width_px)");
   const EdgeMesh m = weld(mesh_antenna);
   const Pose start{T_board_antenna_initial.linear(), T_board_antenna_initial.translation()};
   int max_level = 0;
