@@ -76,7 +76,7 @@ nlohmann::json antenna_json(const AntennaMeasurement& m) {
   const bool ok = !m.error;
   const auto& at = m.attitude;
   a["method"] = m.method;
-  a["verdict"] = registration::to_string(m.verdict);
+  a["verdict"] = ok ? nlohmann::json(registration::to_string(m.verdict)) : nullptr;  // no pose, no verdict
   a["azimuth_magnetic_deg"] = ok ? deg_or_null(at.magnetic.azimuth) : nullptr;
   a["azimuth_true_deg"] = ok ? deg_or_null(at.azimuth_true) : nullptr;
   a["downtilt_deg"] = ok ? nlohmann::json(rad2deg(at.magnetic.downtilt)) : nullptr;
