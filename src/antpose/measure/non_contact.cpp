@@ -88,10 +88,7 @@ void measure_jointly(std::vector<AntennaMeasurement>& antennas, const NonContact
     for (std::size_t k = 0; k < antennas.size(); ++k) {
       const auto* model = setup.model_for(k);
       if (!model || antennas[k].region.rois.empty()) continue;
-      std::vector<KnownBox> neighbours;
-      for (std::size_t j = 0; j < antennas.size(); ++j)
-        if (j != k && !antennas[j].error && setup.model_for(j))
-          neighbours.push_back({antennas[j].T_board_antenna(), setup.model_for(j)->size_m});
+      const auto neighbours = settled_neighbours(antennas, setup, k);
       if (neighbours.empty()) continue;
       AntennaMeasurement again;
       again.roi = antennas[k].roi, again.region = antennas[k].region, again.region_view = antennas[k].region_view;
@@ -137,6 +134,18 @@ void refuse_shared_panels(std::vector<AntennaMeasurement>& antennas, const NonCo
 }
 
 }  // namespace
+
+std::vector<KnownBox> settled_neighbours(const std::vector<AntennaMeasurement>& antennas,
+                                         const NonContactSetup& setup, std::size_t k) {
+  std::vector<KnownBox> out;
+  for (std::size_t j = 0; j < antennas.size(); ++j) {
+    const auto& a = antennas[j];
+    if (j == k || a.error || !setup.model_for(j) || a.verdict == registration::RegistrationVerdict::kAmbiguousShape)
+      continue;
+    out.push_back({a.T_board_antenna(), setup.model_for(j)->size_m});
+  }
+  return out;
+}
 
 OptionProblems NonContactOptions::Check() const {
   OptionProblems p;

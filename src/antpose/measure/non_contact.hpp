@@ -82,6 +82,14 @@ struct NonContactResult {
 NonContactResult measure_non_contact(const Capture& capture, const NonContactSetup& setup,
                                      const NonContactOptions& options, Diagnostics& diagnostics);
 
+/// The boxes of antenna k's neighbours that the joint pass takes as known: the other antennas
+/// registered with a model whose box is settled (a unique pose, or front and back open: the same
+/// box). A neighbour whose registration is ambiguous is not known: one of its rival poses may be
+/// the true one, and the pose reported may stand on antenna k itself, where taking it as known
+/// would rule out k's true pose and leave a wrong one unique.
+std::vector<KnownBox> settled_neighbours(const std::vector<AntennaMeasurement>& antennas,
+                                         const NonContactSetup& setup, std::size_t k);
+
 /// The JSON of the command (docs/non-contact.md): per antenna azimuth_magnetic_deg,
 /// azimuth_true_deg (null without a site), downtilt_deg, roll_deg, uncertainty_deg {azimuth,
 /// downtilt, roll}, verdict, fit_rmse_m, photos_used, warnings, and more.
