@@ -254,7 +254,7 @@ registration::AntennaRegistration register_with_mast(const model::AntennaModel& 
   const double held = 1.0 - static_cast<double>(scene.points_board.size()) / std::max<std::size_t>(1, points_before);
   if (held < o.mast_points_share)
     return registration::register_antenna(model, scene, registration::continuing(o.registration), starts);
-  const auto fresh = registration::propose_poses(model, scene, o.registration, false);
+  const auto fresh = registration::propose_poses(model, scene, o.registration);
   starts.insert(starts.end(), fresh.begin(), fresh.end());
   return registration::register_antenna(model, scene, o.registration, starts);
 }
@@ -291,7 +291,11 @@ void measure_antenna(AntennaMeasurement& m, const model::AntennaModel* model, co
     objects.mast = m.mast;  // known from an earlier registration of this antenna
     objects.antenna_depth_m = depths_filling(model->size_m, rect_of(m.roi.roi), c.poses->intrinsics);
     auto scene = registration_scene(*c.poses, c.up_board, m.region, m.region_view, rect_of(m.roi.roi), objects);
-    auto proposals = registration::propose_poses(*model, scene, o.registration, !previous.empty());
+    // A later registration's earlier candidates hold the points' starts: the outline search alone
+    // adds what the scene now known shows.
+    auto proposing = o.registration;
+    proposing.points_start = previous.empty();
+    auto proposals = registration::propose_poses(*model, scene, proposing);
     proposals.insert(proposals.end(), previous.begin(), previous.end());
     auto r = registration::register_antenna(
         *model, scene, previous.empty() ? o.registration : registration::continuing(o.registration), proposals);

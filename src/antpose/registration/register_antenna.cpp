@@ -430,11 +430,10 @@ std::pair<double, bool> roi_fill(const Vec3& size_m, const Iso3& T_board_antenna
 }
 
 std::vector<PoseCandidate> propose_poses(const model::AntennaModel& model, const AntennaScene& s,
-                                         const RegisterOptions& o, bool outline_only) {
+                                         const RegisterOptions& o) {
   throw_unless_ok(o.Check(), "RegisterOptions");
   check_scene(s);
   auto proposals = from_outline(model, s, o);
-  if (outline_only) return proposals;
   const auto by_points = from_points(model, s, o);
   proposals.insert(proposals.end(), by_points.begin(), by_points.end());
   return proposals;

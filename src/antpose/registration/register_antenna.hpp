@@ -129,10 +129,10 @@ struct AntennaRegistration {
   std::vector<std::string> warnings;
 };
 
-/// The strategies' proposals (the outline search; the points' global start unless `outline_only`),
-/// best of each first.
+/// The strategies' proposals (the outline search; the points' global start where
+/// `options.points_start` and the region has points), best of each first.
 std::vector<PoseCandidate> propose_poses(const model::AntennaModel& model, const AntennaScene& scene,
-                                         const RegisterOptions& options, bool outline_only = false);
+                                         const RegisterOptions& options);
 
 /// The proposals refined, judged and selected. A second registration of the same antenna in a
 /// scene that knows more (a mast, neighbours) passes the first one's candidates as proposals;
