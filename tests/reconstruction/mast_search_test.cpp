@@ -73,12 +73,21 @@ TEST(MastSearch, AShortPoleFarAboveTheBoardIsFound) {
   EXPECT_LT(f.axis_offset_m, 0.03);
 }
 
-TEST(MastSearch, TheStructureBehindThePanelFitsBetterThanAnyBeforeIt) {
-  const SyntheticScene s = registration::fixture::make_scene();
+MountSides mount_sides(const SyntheticScene& s, const MastSearchOptions& options = {}) {
   const Vec3 size = model::parametric_panel({}).size_m;
   const Inputs in = inputs(s, size);
-  const auto sides =
-      search_mount_sides(in.views, s.intrinsics, s.mast.up_board, s.T_board_antenna, size, in.occluders, {});
+  return search_mount_sides(in.views, s.intrinsics, s.mast.up_board, s.T_board_antenna, size, in.occluders, options);
+}
+
+double axis_offset(const Mast& found, const Mast& truth) {
+  const Vec3 d = found.axis_point_board - truth.axis_point_board;
+  return (d - d.dot(truth.up_board) * truth.up_board).norm();
+}
+
+TEST(MastSearch, TheStructureBehindThePanelFitsBetterThanAnyBeforeIt) {
+  const SyntheticScene s = registration::fixture::make_scene();
+  const Inputs in = inputs(s, model::parametric_panel({}).size_m);
+  const auto sides = mount_sides(s);
   ASSERT_TRUE(sides.behind && sides.before);
   EXPECT_LT(sides.behind->cost + 0.2, sides.before->cost);
   int better = 0;
@@ -87,11 +96,42 @@ TEST(MastSearch, TheStructureBehindThePanelFitsBetterThanAnyBeforeIt) {
   EXPECT_GE(better, static_cast<int>(in.views.size()) - 1);
 }
 
+// A pole whose radius and axis lie between the grid's nodes: each side's best cylinder is refined
+// onto it, not left at the nearest node (whose outline lies beyond the chamfer's truncation).
+TEST(MastSearch, ThePoleBehindIsRefinedBetweenTheGridsNodes) {
+  registration::fixture::SceneSpec spec;
+  spec.mast_radius_m = 0.17, spec.mast_behind_m = 0.47;
+  const SyntheticScene s = registration::fixture::make_scene(spec);
+  const auto sides = mount_sides(s);
+  ASSERT_TRUE(sides.behind && sides.before);
+  EXPECT_LT(axis_offset(sides.behind->cylinder, s.mast), 0.015);
+  EXPECT_NEAR(sides.behind->cylinder.radius_m, spec.mast_radius_m, 0.008);
+  EXPECT_LT(sides.behind->cost + 0.2, sides.before->cost);
+}
+
+// A pipe whose foot lies within the panel's height, searched up to the panel's top only: only the
+// stretch beside the panel shows it, from the oblique photos (the ends show nothing of it).
+TEST(MastSearch, APipeNoLongerThanThePanelIsFoundBesideIt) {
+  registration::fixture::SceneSpec spec;
+  spec.mast_base_m = spec.antenna_height_m - 0.3, spec.mast_behind_m = 0.5;
+  spec.view_offsets_deg = {-40.0, -30.0, -20.0, 0.0, 20.0, 30.0, 40.0};
+  const SyntheticScene s = registration::fixture::make_scene(spec);
+  MastSearchOptions o;
+  o.above_m = 0.01;
+  const auto sides = mount_sides(s, o);
+  ASSERT_TRUE(sides.behind && sides.before);
+  EXPECT_LT(axis_offset(sides.behind->cylinder, s.mast), 0.03);
+  EXPECT_LT(sides.behind->cost, sides.before->cost);
+}
+
 TEST(MastSearch, ChecksItsOptions) {
   MastSearchOptions o;
   o.step_m = 0.0;
   EXPECT_THROW(find_mast_by_outline({}, {}, Vec3::UnitZ(), Iso3::Identity(), Vec3::Ones(), {}, o),
                std::invalid_argument);
+  o = {};
+  o.refine_evaluations = -1;
+  EXPECT_THROW(search_mount_sides({}, {}, Vec3::UnitZ(), Iso3::Identity(), Vec3::Ones(), {}, o), std::invalid_argument);
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 
 #include <opencv2/core/utility.hpp>
 
@@ -134,6 +135,7 @@ OptionProblems MastSearchOptions::Check() const {
   p.require(hand_height_m >= 0, "hand_height_m", "≥ 0");
   p.require(truncation_px > 0 && min_diameter_map_px > 0, "truncation_px, min_diameter_map_px", "positive");
   p.require(min_views >= 2 && confirm >= 1, "min_views, confirm", "at least 2 and 1");
+  p.require(refine_evaluations >= 0, "refine_evaluations", "≥ 0");
   p.nest("edges", edges.Check());
   return p;
 }
@@ -144,12 +146,16 @@ namespace {
 struct Grid {
   Vertical frame;
   double low = 0, high = 0;  // the stretch searched, heights along up from the panel's centre
+  double footprint = 0;      // the panel's horizontal half-diagonal
   std::vector<Cylinder> cylinders;
+  std::shared_ptr<const CylinderCost> cost;
 };
 
+// The grid scored over the stretches below and above the panel, and beside it where
+// `beside_panel`; nullopt where no stretch below it lies above the ground.
 std::optional<Grid> score_grid(const std::vector<PosedView>& views, const camera::CameraIntrinsics& K,
                                const Vec3& up_board, const Iso3& T_board_panel, const Vec3& size,
-                               const std::vector<std::vector<std::vector<cv::Point2f>>>& occluders,
+                               const std::vector<std::vector<std::vector<cv::Point2f>>>& occluders, bool beside_panel,
                                const MastSearchOptions& o) {
   Grid g;
   Vertical& f = g.frame;
@@ -170,11 +176,13 @@ std::optional<Grid> score_grid(const std::vector<PosedView>& views, const camera
         std::min(lowest_camera, f.up.dot(camera::camera_centre(v.R_camera_board, v.t_camera_board) - f.centre));
   g.low = std::max(bottom - o.below_m, lowest_camera - o.hand_height_m), g.high = top + o.above_m;
   if (!(g.low < bottom - o.gap_m)) return std::nullopt;
-  const std::array<std::pair<double, double>, 2> stretches{std::pair{g.low, bottom - o.gap_m},
-                                                           std::pair{top + o.gap_m, g.high}};
-  const CylinderCost cost(views, K, f, stretches, search_maps(views, K, f, g.low, g.high, occluders, o), o);
+  const std::array<std::pair<double, double>, 2> stretches{
+      std::pair{g.low, bottom - o.gap_m}, std::pair{beside_panel ? bottom - o.gap_m : top + o.gap_m, g.high}};
+  g.cost = std::make_shared<const CylinderCost>(views, K, f, stretches,
+                                                search_maps(views, K, f, g.low, g.high, occluders, o), o);
+  const CylinderCost& cost = *g.cost;
   // Axes outside the panel's footprint (its horizontal half-diagonal) and within reach.
-  const double footprint = 0.5 * size.head<2>().norm();
+  const double footprint = g.footprint = 0.5 * size.head<2>().norm();
   for (double x = -o.reach_m; x <= o.reach_m; x += o.step_m)
     for (double y = -o.reach_m; y <= o.reach_m; y += o.step_m)
       for (const double r : o.radii_m) {
@@ -190,6 +198,57 @@ std::optional<Grid> score_grid(const std::vector<PosedView>& views, const camera
   std::sort(g.cylinders.begin(), g.cylinders.end(),
             [](const Cylinder& a, const Cylinder& b) { return a.cost < b.cost; });
   return g;
+}
+
+// Whether a cylinder lies where the grid's may: outside the panel's footprint, within reach, its
+// radius within the grid's.
+bool in_search(const Grid& g, const Cylinder& c, const MastSearchOptions& o) {
+  const double d = std::hypot(c.x, c.y);
+  return d <= o.reach_m && d > g.footprint + c.radius && c.radius >= o.radii_m.front() && c.radius <= o.radii_m.back();
+}
+
+// A grid cylinder moved to the nearest minimum of its cost by a pattern search (Hooke & Jeeves
+// 1961) over the axis' offset and the radius, from half the grid's step to a sixteenth, where
+// `allowed`. The grid alone leaves an axis up to step/√2 and a radius up to half its spacing off:
+// more than the chamfer's truncation at the map's scale, so a pole between the grid's nodes would
+// score no better than clutter. The moves are the 26 neighbours in (x, y, radius), not the axes
+// alone: a photo's two outline lines lie at the axis' offset ∓ the radius, and a line that lies
+// right stays there only where the offset and the radius move together.
+template <class Allowed>
+Cylinder refined(Cylinder c, const CylinderCost& cost, const Allowed& allowed, const MastSearchOptions& o) {
+  double step = o.step_m / 2;
+  for (int evaluations = 0; step >= o.step_m / 16 && evaluations < o.refine_evaluations;) {
+    Cylinder best = c;
+    for (int move = 0; move < 27; ++move) {
+      if (move == 13) continue;  // (0, 0, 0)
+      Cylinder t = c;
+      t.x += step * (move % 3 - 1), t.y += step * (move / 3 % 3 - 1), t.radius += step * (move / 9 - 1);
+      if (!allowed(t)) continue;
+      cost(t), ++evaluations;
+      if (t.cost < best.cost) best = std::move(t);
+    }
+    if (best.cost < c.cost)
+      c = std::move(best);
+    else
+      step /= 2;
+  }
+  return c;
+}
+
+// The grid's best cylinders at distinct places (not within two steps of a better one), at most
+// `count`, in order.
+template <class Where>
+std::vector<const Cylinder*> distinct_best(const Grid& g, std::size_t count, const Where& where,
+                                           const MastSearchOptions& o) {
+  std::vector<const Cylinder*> best;
+  for (const auto& c : g.cylinders) {
+    if (best.size() >= count || c.cost >= 1.0) break;
+    if (!where(c) || std::any_of(best.begin(), best.end(),
+                                 [&](const Cylinder* t) { return std::hypot(t->x - c.x, t->y - c.y) < 2 * o.step_m; }))
+      continue;
+    best.push_back(&c);
+  }
+  return best;
 }
 
 Mast as_mast(const Grid& g, const Cylinder& c) {
@@ -208,19 +267,14 @@ std::optional<Mast> find_mast_by_outline(const std::vector<PosedView>& views, co
                                          const std::vector<std::vector<std::vector<cv::Point2f>>>& occluders,
                                          const MastSearchOptions& o) {
   throw_unless_ok(o.Check(), "MastSearchOptions");
-  const auto grid = score_grid(views, K, up_board, T_board_panel, size, occluders, o);
+  const auto grid = score_grid(views, K, up_board, T_board_panel, size, occluders, false, o);
   if (!grid) return std::nullopt;
-  std::vector<const Cylinder*> tried;
-  for (const auto& c : grid->cylinders) {
-    if (tried.size() >= o.confirm || c.cost >= 1.0) break;
-    // One start per place: the grid's neighbours of a tried cylinder are the same mast.
-    if (std::any_of(tried.begin(), tried.end(),
-                    [&](const Cylinder* t) { return std::hypot(t->x - c.x, t->y - c.y) < 2 * o.step_m; }))
-      continue;
-    tried.push_back(&c);
+  // One start per place: the grid's neighbours of a tried cylinder are the same mast.
+  for (const Cylinder* c : distinct_best(
+           *grid, o.confirm, [](const Cylinder&) { return true; }, o)) {
     // The grid's stretch is relative to the panel's centre; confirm_mast's heights are the board's.
     const double centre = grid->frame.up.dot(grid->frame.centre);
-    if (auto mast = confirm_mast(as_mast(*grid, c), views, K, centre + grid->low, centre + grid->high, occluders,
+    if (auto mast = confirm_mast(as_mast(*grid, *c), views, K, centre + grid->low, centre + grid->high, occluders,
                                  o.confirmation))
       return mast;
   }
@@ -233,17 +287,21 @@ MountSides search_mount_sides(const std::vector<PosedView>& views, const camera:
                               const MastSearchOptions& o) {
   throw_unless_ok(o.Check(), "MastSearchOptions");
   MountSides sides;
-  const auto grid = score_grid(views, K, up_board, T_board_panel, size, occluders, o);
+  const auto grid = score_grid(views, K, up_board, T_board_panel, size, occluders, true, o);
   if (!grid) return sides;
   // Across the vertical, the boresight's direction; a cylinder on it lies before the panel.
   const Vec3 b = T_board_panel.linear().col(1);
   const Vec2 ahead(b.dot(grid->frame.e1), b.dot(grid->frame.e2));
   if (ahead.norm() < 1e-6) return sides;
-  for (const auto& c : grid->cylinders) {
-    if (c.cost >= 1.0) break;
-    const double along = Vec2(c.x, c.y).dot(ahead.normalized());
-    auto& side = along < 0.0 ? sides.behind : sides.before;
-    if (!side) side = MountCylinder{as_mast(*grid, c), c.cost, c.view_costs};
+  // Each side's best places, refined without crossing to the other side.
+  for (const double sign : {-1.0, 1.0}) {
+    const auto on_side = [&](const Cylinder& c) { return sign * Vec2(c.x, c.y).dot(ahead) > 0.0; };
+    const auto allowed = [&](const Cylinder& c) { return on_side(c) && in_search(*grid, c, o); };
+    auto& side = sign < 0.0 ? sides.behind : sides.before;
+    for (const Cylinder* start : distinct_best(*grid, o.confirm, on_side, o)) {
+      const Cylinder c = refined(*start, *grid->cost, allowed, o);
+      if (!side || c.cost < side->cost) side = MountCylinder{as_mast(*grid, c), c.cost, c.view_costs};
+    }
   }
   return sides;
 }
