@@ -151,6 +151,13 @@ struct Grid {
   std::shared_ptr<const CylinderCost> cost;
 };
 
+// Whether a cylinder lies where the grid's may: outside the panel's footprint, within reach, its
+// radius within the grid's.
+bool in_search(const Grid& g, const Cylinder& c, const MastSearchOptions& o) {
+  const double d = std::hypot(c.x, c.y);
+  return d <= o.reach_m && d > g.footprint + c.radius && c.radius >= o.radii_m.front() && c.radius <= o.radii_m.back();
+}
+
 // The grid scored over the stretches below and above the panel, and beside it where
 // `beside_panel`; nullopt where no stretch below it lies above the ground.
 std::optional<Grid> score_grid(const std::vector<PosedView>& views, const camera::CameraIntrinsics& K,
@@ -182,15 +189,13 @@ std::optional<Grid> score_grid(const std::vector<PosedView>& views, const camera
                                                 search_maps(views, K, f, g.low, g.high, occluders, o), o);
   const CylinderCost& cost = *g.cost;
   // Axes outside the panel's footprint (its horizontal half-diagonal) and within reach.
-  const double footprint = g.footprint = 0.5 * size.head<2>().norm();
+  g.footprint = 0.5 * size.head<2>().norm();
   for (double x = -o.reach_m; x <= o.reach_m; x += o.step_m)
     for (double y = -o.reach_m; y <= o.reach_m; y += o.step_m)
       for (const double r : o.radii_m) {
-        const double d = std::hypot(x, y);
-        if (d <= o.reach_m && d > footprint + r) {
-          Cylinder& c = g.cylinders.emplace_back();
-          c.x = x, c.y = y, c.radius = r;
-        }
+        Cylinder c;
+        c.x = x, c.y = y, c.radius = r;
+        if (in_search(g, c, o)) g.cylinders.push_back(c);
       }
   cv::parallel_for_(cv::Range(0, static_cast<int>(g.cylinders.size())), [&](const cv::Range& range) {
     for (int i = range.start; i < range.end; ++i) cost(g.cylinders[static_cast<std::size_t>(i)]);
@@ -198,13 +203,6 @@ std::optional<Grid> score_grid(const std::vector<PosedView>& views, const camera
   std::sort(g.cylinders.begin(), g.cylinders.end(),
             [](const Cylinder& a, const Cylinder& b) { return a.cost < b.cost; });
   return g;
-}
-
-// Whether a cylinder lies where the grid's may: outside the panel's footprint, within reach, its
-// radius within the grid's.
-bool in_search(const Grid& g, const Cylinder& c, const MastSearchOptions& o) {
-  const double d = std::hypot(c.x, c.y);
-  return d <= o.reach_m && d > g.footprint + c.radius && c.radius >= o.radii_m.front() && c.radius <= o.radii_m.back();
 }
 
 // A grid cylinder moved to the nearest minimum of its cost by a pattern search (Hooke & Jeeves

@@ -56,9 +56,9 @@ std::optional<Mast> find_mast_by_outline(const std::vector<PosedView>& views,
 /// The vertical structure on each side of a panel: of the grid's cylinders (file comment, scored
 /// beside the panel too, the panel masked: a mount's pipe may be shorter than the panel it holds,
 /// and is then seen only beside it, from oblique views), each side's best few places refined off
-/// the grid by a pattern search, the one whose outline fits
-/// best behind the panel's back plate (against its boresight y_a at `T_board_panel`) and the one
-/// before its front, each with its cost photo by photo (NaN where a photo shows too little of it).
+/// the grid by a pattern search, the one whose outline fits best behind the panel's back plate
+/// (against its boresight y_a at `T_board_panel`) and the one before its front, each with its cost
+/// photo by photo (NaN where a photo shows too little of it).
 /// A panel hangs on a mast, pipe or frame behind it and faces open space: the side whose best
 /// cylinder the photos support better is its back (registration's front and back,
 /// pose_evidence.hpp).
