@@ -10,6 +10,7 @@
 #pragma once
 
 #include <cstddef>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -20,6 +21,7 @@
 #include "antpose/core/error.hpp"
 #include "antpose/io/capture.hpp"
 #include "antpose/reconstruction/reconstruct.hpp"
+#include "antpose/registration/edge_pyramid.hpp"
 
 namespace antpose::measure {
 
@@ -37,6 +39,9 @@ struct CameraPoses {
   std::vector<std::string> skipped;              // "image: reason" for every photo without a pose
   reconstruction::RefinedPoses refined;          // of `views`, in the same order
   std::vector<std::string> warnings;
+  /// Per view (or empty): the photo's edge images, shared by every registration's outline
+  /// refinements in it (registration/edge_pyramid.hpp); see share_edge_images.
+  std::vector<std::shared_ptr<registration::EdgePyramid>> edges;
 
   /// The view showing capture.shots[shot], if it has a pose.
   std::optional<std::size_t> view_of_shot(std::size_t shot) const;
@@ -47,5 +52,9 @@ struct CameraPoses {
 CameraPoses estimate_camera_poses(const Capture& capture, const camera::BoardSpec& board,
                                   const camera::CameraIntrinsics& calibrated, const CameraPoseOptions& options,
                                   Diagnostics& diagnostics, const reconstruction::Progress& progress = {});
+
+/// Gives every view of `poses` one shared edge-image cache prepared as `settings` say (the
+/// registration's gamma and smoothing).
+void share_edge_images(CameraPoses& poses, const registration::EdgePyramidSettings& settings);
 
 }  // namespace antpose::measure

@@ -168,8 +168,12 @@ NonContactResult measure_non_contact(const Capture& capture, const NonContactSet
   NonContactResult result;
   for (const auto& s : capture.shots) result.photos.push_back(s.image);
   const auto progress = [&](const std::string& s, int d, int t) { report(options, s, d, t); };
-  const CameraPoses poses =
-      estimate_camera_poses(capture, setup.board, setup.intrinsics, options.poses, diagnostics, progress);
+  CameraPoses poses = estimate_camera_poses(capture, setup.board, setup.intrinsics, options.poses, diagnostics, progress);
+  const auto& refine = options.antenna.registration.refine;
+  registration::EdgePyramidSettings edges;
+  edges.gamma = refine.gamma, edges.smoothing_sigma_px = refine.smoothing_sigma_px;
+  edges.min_levels = refine.max_level + 1;
+  share_edge_images(poses, edges);
   check_rois_inside(setup, poses.intrinsics);
   result.posed = poses.shot_of_view, result.skipped = poses.skipped;
   result.intrinsics = poses.intrinsics, result.poses = poses.refined;

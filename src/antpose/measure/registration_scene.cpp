@@ -133,6 +133,7 @@ registration::AntennaScene registration_scene(const CameraPoses& poses, const Ve
     s.viewpoints_board.push_back(camera);
     registration::SilhouetteView& v = s.views.emplace_back();
     v.image = pv.image, v.R_camera_board = pv.R_camera_board, v.t_camera_board = pv.t_camera_board;
+    if (i < poses.edges.size()) v.edges = poses.edges[i];
     add_known(v, board_outline(objects.board_box, s.intrinsics, v.R_camera_board, v.t_camera_board), true);
     if (objects.mast) add_mast(v, *objects.mast, s.intrinsics, camera, centre);
     for (const auto& b : objects.neighbours)

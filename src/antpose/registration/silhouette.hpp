@@ -52,6 +52,7 @@
 #pragma once
 
 #include <array>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -61,6 +62,7 @@
 #include "antpose/camera/camera_model.hpp"
 #include "antpose/geometry/point_cloud.hpp"
 #include "antpose/model/mesh.hpp"
+#include "antpose/registration/edge_pyramid.hpp"
 
 namespace antpose::registration {
 
@@ -80,6 +82,10 @@ struct SilhouetteView {
   /// taken): within mask_guard_px of them the antenna's outline cannot be told from theirs, and
   /// neither outline points nor edges there are used.
   std::vector<std::vector<cv::Point2f>> background_edges;
+  /// The photo's edge images (edge_pyramid.hpp), shared by every view of this photo so that each
+  /// crop is prepared once; nullptr (or one made with another gamma or smoothing): each
+  /// refinement prepares its own.
+  std::shared_ptr<EdgePyramid> edges;
 };
 
 struct SilhouetteOptions {

@@ -358,19 +358,22 @@ PreparedViews prepare_views(const EdgeMesh& m, const std::vector<Pose>& poses, c
     for (int i = r.start; i < r.end; ++i) {
       auto& v = prepared[i];
       if (!v.usable) continue;
-      const cv::Mat crop = views[i].image(
-          cv::Rect(static_cast<int>(v.offset.x()), static_cast<int>(v.offset.y()), v.size.width, v.size.height));
-      cv::Mat level = camera::linear_intensity(crop, options.gamma);
-      const bool with_mask = !views[i].occluders.empty() || !views[i].background_edges.empty();
+      const auto& in = views[i];
+      const cv::Rect crop(static_cast<int>(v.offset.x()), static_cast<int>(v.offset.y()), v.size.width, v.size.height);
+      const auto& shared = in.edges;
+      const bool cached = shared && shared->serves(options.gamma, options.smoothing_sigma_px);
+      EdgePyramid own(in.image, EdgePyramidSettings::single_use(options.gamma, options.smoothing_sigma_px));
+      auto levels =
+          (cached ? *shared : own).gradients(crop, out.top + 1, options.gamma, options.smoothing_sigma_px);
+      v.offset = Vec2(levels.crop.x, levels.crop.y);
+      v.size = levels.crop.size();
+      const bool with_mask = !in.occluders.empty() || !in.background_edges.empty();
       for (int l = 0; l <= out.top; ++l) {
-        if (l > 0) {
-          cv::Mat down;
-          cv::pyrDown(level, down);
-          level = down;
-        }
-        auto [gx, gy] = camera::smoothed_gradients(level, options.smoothing_sigma_px);
+        cv::Mat gx = levels.gx[static_cast<std::size_t>(l)], gy = levels.gy[static_cast<std::size_t>(l)];
         if (with_mask) {
-          v.mask.push_back(level_mask(views[i], v.offset, level.size(), l, options.mask_guard_px));
+          // The shared images stay as they are: this view's known objects are its own.
+          v.mask.push_back(level_mask(in, v.offset, gx.size(), l, options.mask_guard_px));
+          gx = gx.clone(), gy = gy.clone();
           gx.setTo(0, v.mask.back());
           gy.setTo(0, v.mask.back());
         }
