@@ -88,7 +88,8 @@ CameraPoses estimate_camera_poses(const Capture& capture, const camera::BoardSpe
 
 void share_edge_images(CameraPoses& poses, const registration::EdgePyramidSettings& settings) {
   poses.edges.clear();
-  for (const auto& v : poses.views) poses.edges.push_back(std::make_shared<registration::EdgePyramid>(v.image, settings));
+  for (const auto& v : poses.views)
+    poses.edges.push_back(std::make_shared<registration::EdgePyramid>(v.image, settings));
 }
 
 }  // namespace antpose::measure

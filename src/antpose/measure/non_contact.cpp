@@ -135,8 +135,8 @@ void refuse_shared_panels(std::vector<AntennaMeasurement>& antennas, const NonCo
 
 }  // namespace
 
-std::vector<KnownBox> settled_neighbours(const std::vector<AntennaMeasurement>& antennas,
-                                         const NonContactSetup& setup, std::size_t k) {
+std::vector<KnownBox> settled_neighbours(const std::vector<AntennaMeasurement>& antennas, const NonContactSetup& setup,
+                                         std::size_t k) {
   std::vector<KnownBox> out;
   for (std::size_t j = 0; j < antennas.size(); ++j) {
     const auto& a = antennas[j];
@@ -168,7 +168,8 @@ NonContactResult measure_non_contact(const Capture& capture, const NonContactSet
   NonContactResult result;
   for (const auto& s : capture.shots) result.photos.push_back(s.image);
   const auto progress = [&](const std::string& s, int d, int t) { report(options, s, d, t); };
-  CameraPoses poses = estimate_camera_poses(capture, setup.board, setup.intrinsics, options.poses, diagnostics, progress);
+  CameraPoses poses =
+      estimate_camera_poses(capture, setup.board, setup.intrinsics, options.poses, diagnostics, progress);
   const auto& refine = options.antenna.registration.refine;
   registration::EdgePyramidSettings edges;
   edges.gamma = refine.gamma, edges.smoothing_sigma_px = refine.smoothing_sigma_px;

@@ -17,8 +17,7 @@ cv::Rect align_to_grid(const cv::Rect& crop, int grid, const cv::Rect& bounds) {
   return cv::Rect(x0, y0, up(crop.x + crop.width) - x0, up(crop.y + crop.height) - y0) & bounds;
 }
 
-EdgePyramid::EdgePyramid(cv::Mat image, EdgePyramidSettings settings)
-    : image_(std::move(image)), settings_(settings) {
+EdgePyramid::EdgePyramid(cv::Mat image, EdgePyramidSettings settings) : image_(std::move(image)), settings_(settings) {
   if (image_.type() != CV_8UC1) throw std::invalid_argument("EdgePyramid: the photo must be CV_8UC1");
   if (!(settings_.growth >= 0) || settings_.max_crops < 1 || settings_.min_levels < 1 || settings_.min_levels > 12)
     throw std::invalid_argument("EdgePyramid: growth must be ≥ 0, max_crops ≥ 1 and min_levels 1..12");
@@ -68,9 +67,9 @@ EdgeLevels EdgePyramid::gradients(const cv::Rect& crop, int levels, double gamma
     const int keep_levels = std::max(levels, settings_.min_levels);
     const int gx = static_cast<int>(std::ceil(settings_.growth * asked.width));
     const int gy = static_cast<int>(std::ceil(settings_.growth * asked.height));
-    const cv::Rect grown = align_to_grid(cv::Rect(asked.x - gx, asked.y - gy, asked.width + 2 * gx,
-                                                  asked.height + 2 * gy),
-                                         1 << (keep_levels - 1), photo);
+    const cv::Rect grown =
+        align_to_grid(cv::Rect(asked.x - gx, asked.y - gy, asked.width + 2 * gx, asked.height + 2 * gy),
+                      1 << (keep_levels - 1), photo);
     if (kept_.size() >= settings_.max_crops)
       kept_.erase(std::min_element(kept_.begin(), kept_.end(),
                                    [](const Kept& a, const Kept& b) { return a.last_use < b.last_use; }));

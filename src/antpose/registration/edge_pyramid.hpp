@@ -28,7 +28,7 @@ struct EdgeLevels {
 };
 
 struct EdgePyramidSettings {
-  double gamma = 2.2;              // photo encoding undone (camera::linear_intensity); 0: as stored
+  double gamma = 2.2;               // photo encoding undone (camera::linear_intensity); 0: as stored
   double smoothing_sigma_px = 1.0;  // Gaussian before the gradient, per level
   /// Each computed crop is grown by this share of its size on every side (0: as asked), so that
   /// crops asked for nearby are served from it.
