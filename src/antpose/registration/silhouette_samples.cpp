@@ -360,11 +360,11 @@ PreparedViews prepare_views(const EdgeMesh& m, const std::vector<Pose>& poses, c
       if (!v.usable) continue;
       const auto& in = views[i];
       const cv::Rect crop(static_cast<int>(v.offset.x()), static_cast<int>(v.offset.y()), v.size.width, v.size.height);
-      const auto& shared = in.edges;
-      const bool cached = shared && shared->serves(options.gamma, options.smoothing_sigma_px);
-      EdgePyramid own(in.image, EdgePyramidSettings::single_use(options.gamma, options.smoothing_sigma_px));
-      auto levels =
-          (cached ? *shared : own).gradients(crop, out.top + 1, options.gamma, options.smoothing_sigma_px);
+      const double gamma = options.gamma, sigma = options.smoothing_sigma_px;
+      const EdgeLevels levels = in.edges && in.edges->serves(gamma, sigma)
+                                    ? in.edges->gradients(crop, out.top + 1, gamma, sigma)
+                                    : EdgePyramid(in.image, EdgePyramidSettings::single_use(gamma, sigma))
+                                          .gradients(crop, out.top + 1, gamma, sigma);
       v.offset = Vec2(levels.crop.x, levels.crop.y);
       v.size = levels.crop.size();
       const bool with_mask = !in.occluders.empty() || !in.background_edges.empty();
