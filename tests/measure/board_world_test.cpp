@@ -174,7 +174,7 @@ TEST(AntennaAttitude, ComposesBoardAndRegistrationWithTrueNorth) {
   geomag::SiteField site;
   site.declination = deg2rad(-6.0);
   site.declination_sigma = deg2rad(0.35);
-  const auto r = antenna_attitude(board, R_board_antenna, cov_reg, site);
+  const auto r = antenna_attitude(board, R_board_antenna, {{"registration", cov_reg}}, site);
   ASSERT_TRUE(r.magnetic.azimuth && r.azimuth_true && r.sigma.azimuth);
   EXPECT_NEAR(rad2deg(*r.magnetic.azimuth), 123.0, 0.1);
   EXPECT_NEAR(rad2deg(r.magnetic.downtilt), 6.0, 0.05);

@@ -111,6 +111,26 @@ TEST_F(MeasureCli, TheBenchmarkScoresWhatMeasureAnswers) {
   EXPECT_NEAR(scored["downtilt_error_deg"].get<double>(),
               answer["downtilt_deg"].get<double>() - truth["downtilt_deg"].as<double>(), 1e-6);
   EXPECT_NEAR(scored["azimuth_sigma_deg"].get<double>(), answer["uncertainty_deg"]["azimuth"].get<double>(), 1e-6);
+  // The σ's budget: one share per source, their squares adding up to each angle's σ².
+  const auto& budget = answer["uncertainty_budget_deg"];
+  ASSERT_GE(budget.size(), 3u) << budget;
+  EXPECT_EQ(budget[0]["source"], "board attitude in the world");
+  for (const char* angle : {"azimuth", "downtilt", "roll"}) {
+    double sum = 0.0;
+    for (const auto& share : budget) sum += std::pow(share[angle].get<double>(), 2);
+    EXPECT_NEAR(std::sqrt(sum), answer["uncertainty_deg"][angle].get<double>(), 1e-6) << angle << " in " << budget;
+  }
+}
+
+TEST_F(MeasureCli, TheReportShowsWhatLimitsEachSigma) {
+  const auto folder = *dir_ / "report";
+  const auto r = test::run_cli(
+      measure(capture(), fmt::format("--model {} --roi {} --report '{}'", model_, roi_, folder.string())));
+  ASSERT_EQ(r.status, 0) << r.out << r.err;
+  const auto html = io::read_text(folder / "index.html");
+  EXPECT_THAT(html, HasSubstr("<h2>Uncertainty budget</h2>"));
+  for (const char* source : {"board attitude in the world", "outline noise", "camera poses"})
+    EXPECT_THAT(html, HasSubstr(fmt::format("<td>{}</td>", source)));
 }
 
 TEST_F(MeasureCli, TheBenchmarkNamesACaptureWithoutTruth) {

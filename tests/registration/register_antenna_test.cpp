@@ -122,6 +122,13 @@ TEST(RegisterAntenna, ASecondRegistrationKeepsTheProfiledRounding) {
   EXPECT_LT(rad2deg(rotation_distance(second.T_board_antenna.linear(), s.T_board_antenna.linear())), 1.0);
   EXPECT_NEAR(second.rotation_covariance_board.trace(), first.rotation_covariance_board.trace(),
               0.5 * first.rotation_covariance_board.trace());
+  // The covariance by its sources: the outline's parts and the profiled shape's spread.
+  Mat3 sum = Mat3::Zero();
+  std::vector<std::string> sources;
+  for (const auto& part : second.rotation_covariance_sources) sum += part.covariance, sources.push_back(part.source);
+  EXPECT_TRUE(sum.isApprox(second.rotation_covariance_board, 1e-12));
+  EXPECT_EQ(sources, (std::vector<std::string>{"outline noise", "model shape tolerance", "edge bias", "outline width",
+                                               "panel shape profile"}));
 }
 
 // Started only in a mirror yaw's basin (yaw_turns.hpp), where the outline alone would keep it,

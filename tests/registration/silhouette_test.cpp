@@ -70,6 +70,11 @@ TEST(Silhouette, RecoversYawFromAPerturbedStart) {
   for (const auto& w : r.warnings) std::printf("warning: %s\n", w.c_str());
   EXPECT_TRUE(r.converged);
   EXPECT_EQ(r.views_used, s.views.size());
+  // The covariance's parts (one per source) add up to it, and each is a covariance of its own.
+  const auto& parts = r.covariance_parts;
+  EXPECT_TRUE(r.covariance.isApprox(parts.noise + parts.shape + parts.edge_bias + parts.dilation, 1e-12));
+  for (const auto* part : {&parts.noise, &parts.shape, &parts.edge_bias, &parts.dilation})
+    EXPECT_GT((part->topLeftCorner<3, 3>().trace()), 0.0);
   EXPECT_LT(std::abs(after.z()), 0.3);
   EXPECT_LT(std::abs(after.x()), 0.15);
   EXPECT_LT(std::abs(after.y()), 0.15);

@@ -36,6 +36,14 @@ Mat3 rotation_from_attitude(double azimuth, double downtilt, double roll);
 /// vertical, azimuth and roll are left empty: only their sum/difference is observable there.
 AntennaAttitude attitude_from_rotation(const Mat3& R_world_antenna, double vertical_limit = kDefaultVerticalLimit);
 
+/// One independent source of an attitude's uncertainty: its rotation covariance (rad², left
+/// perturbation, R_true = exp(δ) R_est, in the frame its owner names). Independent sources' covariances
+/// add, so a list of them is the uncertainty's budget.
+struct UncertaintySource {
+  std::string source;  // as reports name it, e.g. "camera poses"
+  Mat3 covariance = Mat3::Zero();
+};
+
 /// 1σ of the attitude angles (rad) when R_world_antenna is uncertain by a world-frame rotation
 /// vector δ (R_true = exp(δ) R_est) of covariance `covariance_world` (rad²): first-order
 /// propagation through attitude_from_rotation, J Σ Jᵀ, with J by central differences. Azimuth
@@ -58,10 +66,10 @@ std::optional<double> heading_from_north(const Vec3& v_world, double vertical_li
 /// back of the phone touches the plate and the screen faces the person behind the antenna,
 /// so z_device = -y_a.
 enum class ContactPlacement {
-  kTopUp,        // phone's top points up the panel (default): x_d = x_a, y_d = z_a
-  kTopDown,      // upside down: x_d = -x_a, y_d = -z_a
-  kTopRight,     // across the panel, top towards the antenna's right: y_d = x_a, x_d = -z_a
-  kTopLeft,      // across the panel, top towards the antenna's left: y_d = -x_a, x_d = z_a
+  kTopUp,     // phone's top points up the panel (default): x_d = x_a, y_d = z_a
+  kTopDown,   // upside down: x_d = -x_a, y_d = -z_a
+  kTopRight,  // across the panel, top towards the antenna's right: y_d = x_a, x_d = -z_a
+  kTopLeft,   // across the panel, top towards the antenna's left: y_d = -x_a, x_d = z_a
 };
 
 /// R_device_antenna for a placement; kTopUp has columns (e_x, -e_z, e_y).

@@ -6,10 +6,17 @@
 namespace antpose::measure {
 
 AntennaAttitudeResult antenna_attitude(const BoardWorldAttitude& board, const Mat3& R_board_antenna,
-                                       const Mat3& cov_board, const std::optional<geomag::SiteField>& site) {
+                                       const std::vector<UncertaintySource>& sources_board,
+                                       const std::optional<geomag::SiteField>& site) {
   AntennaAttitudeResult r;
   r.R_world_antenna = board.R_world_board * R_board_antenna;
-  r.covariance = board.covariance + board.R_world_board * cov_board * board.R_world_board.transpose();
+  r.covariance = board.covariance;
+  r.budget.push_back({"board attitude in the world", attitude_sigma(r.R_world_antenna, board.covariance)});
+  for (const auto& part : sources_board) {
+    const Mat3 world = board.R_world_board * part.covariance * board.R_world_board.transpose();
+    r.covariance += world;
+    r.budget.push_back({part.source, attitude_sigma(r.R_world_antenna, world)});
+  }
   r.magnetic = attitude_from_rotation(r.R_world_antenna);
   r.sigma = attitude_sigma(r.R_world_antenna, r.covariance);
   r.warnings = board.warnings;
@@ -27,6 +34,7 @@ double widen_for_rivals(AntennaAttitudeResult& at, const Mat3& R_result, const s
   const auto widen = [](auto& sigma, double difference) {
     if (sigma) sigma = std::hypot(*sigma, difference / 2);
   };
+  const AttitudeSigma before = at.sigma;
   double turn = 0.0;
   for (const Mat3& R : rivals_board) {
     turn = std::max(turn, angle_between(R.col(1), R_result.col(1)));
@@ -36,7 +44,7 @@ double widen_for_rivals(AntennaAttitudeResult& at, const Mat3& R_result, const s
         R_result * Eigen::AngleAxisd(std::atan2(-boresight.x(), boresight.y()), Vec3::UnitZ()).toRotationMatrix();
     double d_azimuth = 0.0, d_downtilt = 0.0, d_roll = 0.0;
     for (const Mat3& R_other : {R, R_about_axis}) {
-      const auto other = antenna_attitude(board, R_other, Mat3::Zero(), site).magnetic;
+      const auto other = antenna_attitude(board, R_other, {}, site).magnetic;
       if (at.magnetic.azimuth && other.azimuth)
         d_azimuth = std::max(d_azimuth, std::abs(wrap_pi(*other.azimuth - *at.magnetic.azimuth)));
       d_downtilt = std::max(d_downtilt, std::abs(other.downtilt - at.magnetic.downtilt));
@@ -46,6 +54,16 @@ double widen_for_rivals(AntennaAttitudeResult& at, const Mat3& R_result, const s
     widen(at.azimuth_true_sigma, d_azimuth);
     at.sigma.downtilt = std::hypot(at.sigma.downtilt, d_downtilt / 2);
     widen(at.sigma.roll, d_roll);
+  }
+  if (!rivals_board.empty()) {
+    // The widening's own share: what it added in quadrature.
+    const auto added = [](const std::optional<double>& now, const std::optional<double>& was) -> std::optional<double> {
+      if (!now || !was) return std::nullopt;
+      return std::sqrt(std::max(0.0, *now * *now - *was * *was));
+    };
+    at.budget.push_back({"rival poses",
+                         {added(at.sigma.azimuth, before.azimuth), *added(at.sigma.downtilt, before.downtilt),
+                          added(at.sigma.roll, before.roll)}});
   }
   return turn;
 }

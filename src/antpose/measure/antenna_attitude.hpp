@@ -18,20 +18,32 @@
 
 namespace antpose::measure {
 
+/// The σ one source of uncertainty alone gives each angle (rad). The sources are independent and the
+/// propagation linear, so each angle's σ² is the sum of its shares' squares: the budget says what
+/// limits a measurement (the compass, the outline, the camera poses, a rival pose).
+struct SigmaShare {
+  std::string source;
+  AttitudeSigma sigma;
+};
+
 struct AntennaAttitudeResult {
   Mat3 R_world_antenna = Mat3::Identity();  // world = ENU, magnetic north
   Mat3 covariance = Mat3::Zero();           // rad², world frame
   AntennaAttitude magnetic;                 // azimuth is magnetic
   AttitudeSigma sigma;
+  /// sigma by source (magnetic angles): the board's attitude in the world first, then each of the
+  /// registration's sources, then any widening for rival poses.
+  std::vector<SigmaShare> budget;
   std::optional<double> azimuth_true;        // rad, with a site
   std::optional<double> azimuth_true_sigma;  // rad
   std::vector<std::string> warnings;
 };
 
-/// `R_board_antenna` with covariance `cov_board` (rad², board frame, left perturbation);
-/// `site` gives the declination (none: no true azimuth).
+/// `R_board_antenna` with the covariance of its independent `sources` (rad², board frame, left
+/// perturbation; none: the board's alone); `site` gives the declination (none: no true azimuth).
 AntennaAttitudeResult antenna_attitude(const BoardWorldAttitude& board, const Mat3& R_board_antenna,
-                                       const Mat3& cov_board, const std::optional<geomag::SiteField>& site);
+                                       const std::vector<UncertaintySource>& sources_board,
+                                       const std::optional<geomag::SiteField>& site);
 
 /// Widens `result`'s σ (of R_board_antenna) for poses that fit about as well (`rivals_board`):
 /// each angle's σ to half its difference from each rival's (the spread of a two-way mixture).
@@ -41,7 +53,8 @@ AntennaAttitudeResult antenna_attitude(const BoardWorldAttitude& board, const Ma
 /// angle takes the larger of its differences to the rival and to R_board_antenna turned by the
 /// rival's boresight angle about its own z (a panel 3.9° down, 13.8° off about its own axis,
 /// reads as −0.99° of roll, where a rival 30° round about the vertical would leave the roll's σ
-/// at 0.18°). Returns the largest angle between the rivals' boresights and the result's (rad).
+/// at 0.18°). The widening joins the budget as "rival poses". Returns the largest angle between the
+/// rivals' boresights and the result's (rad).
 double widen_for_rivals(AntennaAttitudeResult& result, const Mat3& R_board_antenna,
                         const std::vector<Mat3>& rivals_board, const BoardWorldAttitude& board,
                         const std::optional<geomag::SiteField>& site);

@@ -91,7 +91,7 @@ double side_view_azimuth_deg(const Mat3& R_board_antenna, const BoardWorldAttitu
 // refuse the antenna, naming both answers and the photo that would settle them.
 void explain_verdict(AntennaMeasurement& m, const registration::AntennaRegistration& r, const CaptureContext& c) {
   if (r.verdict == registration::RegistrationVerdict::kFrontBackOpen) {
-    const auto a = antenna_attitude(*c.board, m.R_board_antenna, Mat3::Zero(), *c.site).magnetic;
+    const auto a = antenna_attitude(*c.board, m.R_board_antenna, {}, *c.site).magnetic;
     const double az = rad2deg(a.azimuth.value_or(0.0));
     m.error = fmt::format(
         "front and back cannot be told apart in these photos (no mast was found behind either face, and neither "
@@ -117,7 +117,8 @@ void apply_registration(AntennaMeasurement& m, const model::AntennaModel& model,
                         const registration::AntennaRegistration& r, const CaptureContext& c, const AntennaOptions& o) {
   m.R_board_antenna = r.T_board_antenna.linear();
   m.p_board_antenna = r.T_board_antenna.translation();
-  m.cov_board = r.rotation_covariance_board + c.cov_poses_board;
+  m.cov_board = r.rotation_covariance_sources;
+  m.cov_board.push_back({"camera poses", c.cov_poses_board});
   for (const auto& rival : r.rivals) m.rivals_board.push_back(rival.linear());
   for (const auto& rival : r.near_rivals) m.rivals_board.push_back(rival.linear());
   m.verdict = r.verdict;
@@ -169,7 +170,7 @@ void measure_model_free(AntennaMeasurement& m, const CaptureContext& c, const An
   m.method = "model-free (front face + long axis)";
   m.R_board_antenna = fit.R_scene_antenna;
   m.p_board_antenna = fit.centre_scene;
-  m.cov_board = fit.covariance + c.cov_poses_board;
+  m.cov_board = {{"front face fit", fit.covariance}, {"camera poses", c.cov_poses_board}};
   m.fit_rmse_m = fit.rmse_m;
   m.fitness = fit.inlier_share;
   m.warnings.insert(m.warnings.end(), fit.warnings.begin(), fit.warnings.end());

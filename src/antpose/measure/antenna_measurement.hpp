@@ -71,9 +71,9 @@ struct AntennaMeasurement {
   std::optional<std::string> error;  // why this antenna has no result (the others may have one)
   std::string method;                // "model NAME, ..." or "model-free (front face + long axis)"
   Mat3 R_board_antenna = Mat3::Identity();
-  Vec3 p_board_antenna = Vec3::Zero();  // m
-  Mat3 cov_board = Mat3::Zero();        // registration, rad², board frame
-  std::vector<Mat3> rivals_board;       // other poses the evidence does not rule out
+  Vec3 p_board_antenna = Vec3::Zero();       // m
+  std::vector<UncertaintySource> cov_board;  // the registration's rotation covariance by source, board frame
+  std::vector<Mat3> rivals_board;            // other poses the evidence does not rule out
   registration::RegistrationVerdict verdict = registration::RegistrationVerdict::kUnique;
   std::optional<registration::Comparison> runner_up;  // the result against the best other pose
   std::optional<registration::Comparison> front_back;

@@ -87,12 +87,13 @@ NonContactResult measure_non_contact(const Capture& capture, const NonContactSet
 /// box). A neighbour whose registration is ambiguous is not known: one of its rival poses may be
 /// the true one, and the pose reported may stand on antenna k itself, where taking it as known
 /// would rule out k's true pose and leave a wrong one unique.
-std::vector<KnownBox> settled_neighbours(const std::vector<AntennaMeasurement>& antennas,
-                                         const NonContactSetup& setup, std::size_t k);
+std::vector<KnownBox> settled_neighbours(const std::vector<AntennaMeasurement>& antennas, const NonContactSetup& setup,
+                                         std::size_t k);
 
 /// The JSON of the command (docs/non-contact.md): per antenna azimuth_magnetic_deg,
 /// azimuth_true_deg (null without a site), downtilt_deg, roll_deg, uncertainty_deg {azimuth,
-/// downtilt, roll}, verdict, fit_rmse_m, photos_used, warnings, and more.
+/// downtilt, roll} and its budget by source (uncertainty_budget_deg), verdict, fit_rmse_m,
+/// photos_used, warnings, and more.
 nlohmann::json to_json(const NonContactResult& result);
 
 }  // namespace antpose::measure

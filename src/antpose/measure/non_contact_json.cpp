@@ -85,6 +85,14 @@ nlohmann::json antenna_json(const AntennaMeasurement& m) {
                           {"azimuth_true", ok ? deg_or_null(at.azimuth_true_sigma) : nullptr},
                           {"downtilt", ok ? nlohmann::json(rad2deg(at.sigma.downtilt)) : nullptr},
                           {"roll", ok ? deg_or_null(at.sigma.roll) : nullptr}};
+  nlohmann::json budget = nlohmann::json::array();
+  if (ok)
+    for (const auto& share : at.budget)
+      budget.push_back({{"source", share.source},
+                        {"azimuth", deg_or_null(share.sigma.azimuth)},
+                        {"downtilt", rad2deg(share.sigma.downtilt)},
+                        {"roll", deg_or_null(share.sigma.roll)}});
+  a["uncertainty_budget_deg"] = budget;
   a["fit_rmse_m"] = ok ? nlohmann::json(m.fit_rmse_m) : nullptr;
   a["fitness"] = ok ? nlohmann::json(m.fitness) : nullptr;
   nlohmann::json poses = nlohmann::json::array();

@@ -73,6 +73,23 @@ std::string angle_cell(const std::optional<double>& value, const std::optional<d
   return fmt::format("{:.{}f}° ± {:.{}f}°", rad2deg(*value), digits, rad2deg(sigma.value_or(0.0)), digits);
 }
 
+std::string sigma_cell(const std::optional<double>& sigma) {
+  return sigma ? fmt::format("{:.2f}°", rad2deg(*sigma)) : std::string("–");
+}
+
+// Each answered antenna's σ by source (antenna_attitude.hpp's budget): what limits it.
+std::string budget_table(const std::vector<AntennaMeasurement>& antennas) {
+  std::string h = "<table><tr><th>#</th><th>source</th><th>azimuth</th><th>downtilt</th><th>roll</th></tr>";
+  for (std::size_t k = 0; k < antennas.size(); ++k) {
+    if (antennas[k].error) continue;
+    for (const auto& share : antennas[k].attitude.budget)
+      h += fmt::format("<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>", k + 1,
+                       io::xml_escape(share.source), sigma_cell(share.sigma.azimuth), sigma_cell(share.sigma.downtilt),
+                       sigma_cell(share.sigma.roll));
+  }
+  return h + "</table>";
+}
+
 // Plan view (east right, north up) of one antenna in the world frame: its points, the model and
 // the boresight, with a north arrow; metres around the antenna's centre.
 std::string plan_svg(const AntennaMeasurement& m, const BoardWorldAttitude& board) {
@@ -178,6 +195,9 @@ std::string html_page(const Capture& capture, const NonContactResult& r, const s
   }
   h += "</table><p>Uncertainties are 1σ. Azimuth clockwise from north, downtilt positive when the antenna points "
        "down, roll positive clockwise seen from behind (docs/non-contact.md).</p>";
+  h += "<h2>Uncertainty budget</h2><p>The σ each independent source alone gives each angle (magnetic azimuth); "
+       "their squares add up to the σ² above.</p>" +
+       budget_table(r.antennas);
   std::vector<std::string> warnings = r.warnings;
   for (const auto& m : r.antennas) {
     if (!m.error) warnings.insert(warnings.end(), m.attitude.warnings.begin(), m.attitude.warnings.end());

@@ -328,6 +328,18 @@ void add_mount_outline(PoseEvidence& as_is, PoseEvidence& twin, const Refined& k
   twin.mount_outline = sides.before->view_costs;
 }
 
+// The rotation covariance of a refined candidate by its sources: its outline's parts, and the spread
+// of the shapes that fit as well where its shape was profiled (shape_fit.hpp).
+std::vector<UncertaintySource> rotation_sources(const Refined& k) {
+  const auto& parts = k.outline.covariance_parts;
+  std::vector<UncertaintySource> out{{"outline noise", parts.noise.topLeftCorner<3, 3>()},
+                                     {"model shape tolerance", parts.shape.topLeftCorner<3, 3>()},
+                                     {"edge bias", parts.edge_bias.topLeftCorner<3, 3>()},
+                                     {"outline width", parts.dilation.topLeftCorner<3, 3>()}};
+  if (k.panel_shape) out.push_back({"panel shape profile", k.panel_shape->spread_board});
+  return out;
+}
+
 // Each candidate judged with its own model (pose_evidence.hpp), and the selection
 // (pose_selection.hpp); the best's front and back also by the vertical structure on its sides.
 AntennaRegistration select(const AntennaScene& s, std::vector<Refined> kept, const RegisterOptions& o) {
@@ -356,8 +368,8 @@ AntennaRegistration select(const AntennaScene& s, std::vector<Refined> kept, con
   // A parametric panel is a box with brackets alike at both ends: its top is the end up.
   const bool symmetric_ends = best.model->panel != nullptr;
   if (symmetric_ends) out.T_board_antenna = upright(out.T_board_antenna, s.up_board);
-  out.rotation_covariance_board = best.outline.covariance.topLeftCorner<3, 3>();
-  if (best.panel_shape) out.rotation_covariance_board += best.panel_shape->spread_board;
+  out.rotation_covariance_sources = rotation_sources(best);
+  for (const auto& part : out.rotation_covariance_sources) out.rotation_covariance_board += part.covariance;
   out.dilation_yaw_sigma_rad = best.outline.dilation_yaw_sigma_rad;
   out.outline_score = best.outline.score, out.outline_rms_px = best.outline.rms_px;
   out.outline_views = best.outline.views_used;

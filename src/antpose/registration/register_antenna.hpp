@@ -30,6 +30,7 @@
 #include <vector>
 
 #include "antpose/core/check.hpp"
+#include "antpose/geometry/attitude.hpp"
 #include "antpose/geometry/oriented_box.hpp"
 #include "antpose/model/antenna_model.hpp"
 #include "antpose/reconstruction/mast.hpp"
@@ -116,8 +117,11 @@ struct AntennaRegistration {
   std::string why_not;  // when not found: why, and what would help
   Iso3 T_board_antenna = Iso3::Identity();
   Mat3 rotation_covariance_board = Mat3::Zero();  // rad², the outline's at the pose (and the shape's spread)
-  std::optional<ShapeFit> panel_shape;            // where the model's shape was refitted
-  double dilation_yaw_sigma_rad = 0.0;            // SilhouetteResult's
+  /// rotation_covariance_board by its sources (board frame), which sum to it: the outline's parts
+  /// (silhouette.hpp OutlineCovarianceParts) and the profiled shape's spread.
+  std::vector<UncertaintySource> rotation_covariance_sources;
+  std::optional<ShapeFit> panel_shape;  // where the model's shape was refitted
+  double dilation_yaw_sigma_rad = 0.0;  // SilhouetteResult's
   double outline_score = 1.0, outline_rms_px = 0.0;
   std::size_t outline_views = 0;
   RegistrationVerdict verdict = RegistrationVerdict::kUnique;

@@ -236,9 +236,10 @@ void covariance_at(SilhouetteResult& result, const Gathered& g, const Normal& n,
   result.rms_px = std::sqrt(n.sum_wr2 / n.sum_w);
   const double sigma2 = n.sum_wr2 / std::max(1.0, n.sum_w - 6.0);
   const double inflation = std::max(1.0, o.correlation_length_px / o.sample_spacing_px);
-  Mat6 M = sigma2 * inflation * n.H;
+  Mat6 noise = sigma2 * inflation * n.H;
   if (prior)
-    M.topLeftCorner<3, 3>() += (prior_weight * prior_weight - sigma2 * inflation * prior_weight) * prior->information;
+    noise.topLeftCorner<3, 3>() +=
+        (prior_weight * prior_weight - sigma2 * inflation * prior_weight) * prior->information;
   std::vector<Vec6> shape(m.edges.size(), Vec6::Zero()), bias(m.edges.size(), Vec6::Zero());
   Vec6 dilation = Vec6::Zero();
   for (const auto& view : g.per_view)
@@ -249,9 +250,15 @@ void covariance_at(SilhouetteResult& result, const Gathered& g, const Normal& n,
       bias[s.edge] += w * o.edge_bias_px * s.J.transpose();
       dilation += w * o.outline_dilation_px * s.J.transpose();
     }
-  for (std::size_t e = 0; e < m.edges.size(); ++e) M += shape[e] * shape[e].transpose() + bias[e] * bias[e].transpose();
-  M += dilation * dilation.transpose();
-  result.covariance = Hinv * M * Hinv;
+  Mat6 shape_M = Mat6::Zero(), bias_M = Mat6::Zero();
+  for (std::size_t e = 0; e < m.edges.size(); ++e)
+    shape_M += shape[e] * shape[e].transpose(), bias_M += bias[e] * bias[e].transpose();
+  auto& parts = result.covariance_parts;
+  parts.noise = Hinv * noise * Hinv;
+  parts.shape = Hinv * shape_M * Hinv;
+  parts.edge_bias = Hinv * bias_M * Hinv;
+  parts.dilation = Hinv * (dilation * dilation.transpose()) * Hinv;
+  result.covariance = parts.noise + parts.shape + parts.edge_bias + parts.dilation;
   result.dilation_yaw_sigma_rad = std::abs((Hinv * dilation).head<3>().dot(pose.R.col(2)));
 }
 

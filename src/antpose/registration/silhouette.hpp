@@ -145,10 +145,21 @@ struct RotationPrior {
   Mat3 information = Mat3::Zero();
 };
 
+/// The outline covariance's independent parts (file comment), each the sandwich H⁻¹ M_part H⁻¹ of
+/// one term of M: they sum to SilhouetteResult::covariance.
+struct OutlineCovarianceParts {
+  using Mat6 = Eigen::Matrix<double, 6, 6>;
+  Mat6 noise = Mat6::Zero();      // white edge noise, inflated for the samples' overlap (and a prior's own)
+  Mat6 shape = Mat6::Zero();      // the model's shape tolerance, common to each mesh edge's samples
+  Mat6 edge_bias = Mat6::Zero();  // edge-localisation bias, common to each mesh edge's samples
+  Mat6 dilation = Mat6::Zero();   // the whole outline found wider or narrower than the model's
+};
+
 struct SilhouetteResult {
   Iso3 T_board_antenna = Iso3::Identity();  // refined; p_board = T p_antenna
   /// (rotation vector δ in the board frame, R_true = exp(δ) R_est; translation, m).
   Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();
+  OutlineCovarianceParts covariance_parts;  // covariance split by its sources
   /// The σ of the turn about the model's z axis (a panel's long axis) that covariance owes to
   /// SilhouetteOptions::outline_dilation_px alone (rad): large where the outline's width barely
   /// changes with yaw (a narrow panel seen face-on), which wider-spread views cure.
