@@ -148,7 +148,7 @@ struct Grid {
   double low = 0, high = 0;  // the stretch searched, heights along up from the panel's centre
   double footprint = 0;      // the panel's horizontal half-diagonal
   std::vector<Cylinder> cylinders;
-  std::shared_ptr<const CylinderCost> cost;
+  std::unique_ptr<const CylinderCost> cost;  // built with the maps; it holds references, so is not assignable
 };
 
 // Whether a cylinder lies where the grid's may: outside the panel's footprint, within reach, its
@@ -185,7 +185,7 @@ std::optional<Grid> score_grid(const std::vector<PosedView>& views, const camera
   if (!(g.low < bottom - o.gap_m)) return std::nullopt;
   const std::array<std::pair<double, double>, 2> stretches{
       std::pair{g.low, bottom - o.gap_m}, std::pair{beside_panel ? bottom - o.gap_m : top + o.gap_m, g.high}};
-  g.cost = std::make_shared<const CylinderCost>(views, K, f, stretches,
+  g.cost = std::make_unique<const CylinderCost>(views, K, f, stretches,
                                                 search_maps(views, K, f, g.low, g.high, occluders, o), o);
   const CylinderCost& cost = *g.cost;
   // Axes outside the panel's footprint (its horizontal half-diagonal) and within reach.
