@@ -35,7 +35,7 @@ TEST(AntennaAttitude, ARivalWidensEachAngleToHalfItsDifference) {
   const auto before = m.result.sigma;
   // A level panel: turning about the vertical or about its own long axis is the same turn.
   const Mat3 R_rival = m.board.R_world_board.transpose() * rotation_from_attitude(deg2rad(143.0), 0.0, 0.0);
-  const double turn = widen_for_rivals(m.result, m.R_board_antenna, {R_rival}, m.board, std::nullopt);
+  const double turn = widen_for_rivals(m.result, m.R_board_antenna, {R_rival}, m.board);
   EXPECT_NEAR(rad2deg(turn), 20.0, 1e-6);
   EXPECT_NEAR(*m.result.sigma.azimuth, std::hypot(*before.azimuth, deg2rad(10.0)), 1e-9);
   EXPECT_NEAR(m.result.sigma.downtilt, before.downtilt, 1e-9);
@@ -49,7 +49,7 @@ TEST(AntennaAttitude, ARivalYawAlsoWidensTheRollAboutTheTiltedAxis) {
   auto m = measured(142.7, 3.9, 0.0);
   const auto before = m.result.sigma;
   const Mat3 R_rival = m.board.R_world_board.transpose() * rotation_from_attitude(deg2rad(172.7), deg2rad(3.9), 0.0);
-  widen_for_rivals(m.result, m.R_board_antenna, {R_rival}, m.board, std::nullopt);
+  widen_for_rivals(m.result, m.R_board_antenna, {R_rival}, m.board);
   // The turn about the panel's own axis as the truth: its roll differs by about yaw · sin(downtilt).
   const Mat3 R_about_axis = m.R_board_antenna * Eigen::AngleAxisd(deg2rad(-30.0), Vec3::UnitZ()).toRotationMatrix();
   const auto turned = attitude_from_rotation(m.board.R_world_board * R_about_axis);
@@ -94,7 +94,7 @@ TEST(AntennaAttitude, ARivalsWideningIsItsOwnShare) {
   const auto before = m.result.sigma;
   const std::size_t sources = m.result.budget.size();
   const Mat3 R_rival = m.board.R_world_board.transpose() * rotation_from_attitude(deg2rad(143.0), 0.0, 0.0);
-  widen_for_rivals(m.result, m.R_board_antenna, {R_rival}, m.board, std::nullopt);
+  widen_for_rivals(m.result, m.R_board_antenna, {R_rival}, m.board);
   ASSERT_EQ(m.result.budget.size(), sources + 1);
   const auto& rival = m.result.budget.back();
   EXPECT_EQ(rival.source, "rival poses");
@@ -106,7 +106,7 @@ TEST(AntennaAttitude, ARivalsWideningIsItsOwnShare) {
 TEST(AntennaAttitude, NoRivalNoWidening) {
   auto m = measured(10.0, 5.0, 1.0);
   const auto before = m.result.sigma;
-  EXPECT_EQ(widen_for_rivals(m.result, m.R_board_antenna, {}, m.board, std::nullopt), 0.0);
+  EXPECT_EQ(widen_for_rivals(m.result, m.R_board_antenna, {}, m.board), 0.0);
   EXPECT_EQ(*m.result.sigma.azimuth, *before.azimuth);
   EXPECT_EQ(m.result.sigma.downtilt, before.downtilt);
   EXPECT_EQ(*m.result.sigma.roll, *before.roll);

@@ -30,7 +30,7 @@ AntennaAttitudeResult antenna_attitude(const BoardWorldAttitude& board, const Ma
 }
 
 double widen_for_rivals(AntennaAttitudeResult& at, const Mat3& R_result, const std::vector<Mat3>& rivals_board,
-                        const BoardWorldAttitude& board, const std::optional<geomag::SiteField>& site) {
+                        const BoardWorldAttitude& board) {
   const auto widen = [](auto& sigma, double difference) {
     if (sigma) sigma = std::hypot(*sigma, difference / 2);
   };
@@ -44,7 +44,7 @@ double widen_for_rivals(AntennaAttitudeResult& at, const Mat3& R_result, const s
         R_result * Eigen::AngleAxisd(std::atan2(-boresight.x(), boresight.y()), Vec3::UnitZ()).toRotationMatrix();
     double d_azimuth = 0.0, d_downtilt = 0.0, d_roll = 0.0;
     for (const Mat3& R_other : {R, R_about_axis}) {
-      const auto other = antenna_attitude(board, R_other, {}, site).magnetic;
+      const auto other = attitude_from_rotation(board.R_world_board * R_other);
       if (at.magnetic.azimuth && other.azimuth)
         d_azimuth = std::max(d_azimuth, std::abs(wrap_pi(*other.azimuth - *at.magnetic.azimuth)));
       d_downtilt = std::max(d_downtilt, std::abs(other.downtilt - at.magnetic.downtilt));
@@ -57,13 +57,13 @@ double widen_for_rivals(AntennaAttitudeResult& at, const Mat3& R_result, const s
   }
   if (!rivals_board.empty()) {
     // The widening's own share: what it added in quadrature.
-    const auto added = [](const std::optional<double>& now, const std::optional<double>& was) -> std::optional<double> {
-      if (!now || !was) return std::nullopt;
-      return std::sqrt(std::max(0.0, *now * *now - *was * *was));
+    const auto added = [](double now, double was) { return std::sqrt(std::max(0.0, now * now - was * was)); };
+    const auto added_to = [&](const std::optional<double>& now, const std::optional<double>& was) {
+      return now && was ? std::optional<double>(added(*now, *was)) : std::nullopt;
     };
     at.budget.push_back({"rival poses",
-                         {added(at.sigma.azimuth, before.azimuth), *added(at.sigma.downtilt, before.downtilt),
-                          added(at.sigma.roll, before.roll)}});
+                         {added_to(at.sigma.azimuth, before.azimuth), added(at.sigma.downtilt, before.downtilt),
+                          added_to(at.sigma.roll, before.roll)}});
   }
   return turn;
 }

@@ -56,7 +56,6 @@ AntennaAttitudeResult antenna_attitude(const BoardWorldAttitude& board, const Ma
 /// at 0.18°). The widening joins the budget as "rival poses". Returns the largest angle between the
 /// rivals' boresights and the result's (rad).
 double widen_for_rivals(AntennaAttitudeResult& result, const Mat3& R_board_antenna,
-                        const std::vector<Mat3>& rivals_board, const BoardWorldAttitude& board,
-                        const std::optional<geomag::SiteField>& site);
+                        const std::vector<Mat3>& rivals_board, const BoardWorldAttitude& board);
 
 }  // namespace antpose::measure

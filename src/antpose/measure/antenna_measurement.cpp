@@ -91,7 +91,7 @@ double side_view_azimuth_deg(const Mat3& R_board_antenna, const BoardWorldAttitu
 // refuse the antenna, naming both answers and the photo that would settle them.
 void explain_verdict(AntennaMeasurement& m, const registration::AntennaRegistration& r, const CaptureContext& c) {
   if (r.verdict == registration::RegistrationVerdict::kFrontBackOpen) {
-    const auto a = antenna_attitude(*c.board, m.R_board_antenna, {}, *c.site).magnetic;
+    const auto a = attitude_from_rotation(c.board->R_world_board * m.R_board_antenna);
     const double az = rad2deg(a.azimuth.value_or(0.0));
     m.error = fmt::format(
         "front and back cannot be told apart in these photos (no mast was found behind either face, and neither "
@@ -314,7 +314,7 @@ void measure_antenna(AntennaMeasurement& m, const model::AntennaModel* model, co
     if (m.error) return;
   }
   m.attitude = antenna_attitude(*c.board, m.R_board_antenna, m.cov_board, *c.site);
-  if (!m.rivals_board.empty()) widen_for_rivals(m.attitude, m.R_board_antenna, m.rivals_board, *c.board, *c.site);
+  if (!m.rivals_board.empty()) widen_for_rivals(m.attitude, m.R_board_antenna, m.rivals_board, *c.board);
 }
 
 }  // namespace antpose::measure

@@ -369,7 +369,6 @@ AntennaRegistration select(const AntennaScene& s, std::vector<Refined> kept, con
   const bool symmetric_ends = best.model->panel != nullptr;
   if (symmetric_ends) out.T_board_antenna = upright(out.T_board_antenna, s.up_board);
   out.rotation_covariance_sources = rotation_sources(best);
-  for (const auto& part : out.rotation_covariance_sources) out.rotation_covariance_board += part.covariance;
   out.dilation_yaw_sigma_rad = best.outline.dilation_yaw_sigma_rad;
   out.outline_score = best.outline.score, out.outline_rms_px = best.outline.rms_px;
   out.outline_views = best.outline.views_used;
@@ -449,6 +448,12 @@ std::vector<PoseCandidate> propose_poses(const model::AntennaModel& model, const
   const auto by_points = from_points(model, s, o);
   proposals.insert(proposals.end(), by_points.begin(), by_points.end());
   return proposals;
+}
+
+Mat3 AntennaRegistration::rotation_covariance_board() const {
+  Mat3 sum = Mat3::Zero();
+  for (const auto& part : rotation_covariance_sources) sum += part.covariance;
+  return sum;
 }
 
 RegisterOptions continuing(RegisterOptions options) {

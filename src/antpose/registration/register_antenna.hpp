@@ -116,8 +116,7 @@ struct AntennaRegistration {
   bool found = false;
   std::string why_not;  // when not found: why, and what would help
   Iso3 T_board_antenna = Iso3::Identity();
-  Mat3 rotation_covariance_board = Mat3::Zero();  // rad², the outline's at the pose (and the shape's spread)
-  /// rotation_covariance_board by its sources (board frame), which sum to it: the outline's parts
+  /// The pose's rotation covariance by its sources (rad², board frame): the outline's parts
   /// (silhouette.hpp OutlineCovarianceParts) and the profiled shape's spread.
   std::vector<UncertaintySource> rotation_covariance_sources;
   std::optional<ShapeFit> panel_shape;  // where the model's shape was refitted
@@ -131,6 +130,8 @@ struct AntennaRegistration {
   std::vector<PoseCandidate> candidates;  // refined, distinct, with their evidence
   std::size_t proposed = 0;               // candidates the strategies proposed
   std::vector<std::string> warnings;
+
+  Mat3 rotation_covariance_board() const;  // the sources' sum
 };
 
 /// The strategies' proposals (the outline search; the points' global start where
