@@ -6,6 +6,7 @@
 
 #include <fmt/core.h>
 
+#include "antpose/core/allocator.hpp"
 #include "commands.hpp"
 
 namespace antpose::cli {
@@ -25,6 +26,7 @@ std::vector<std::string> split_list(const std::string& text) {
 }  // namespace antpose::cli
 
 int main(int argc, char** argv) {
+  antpose::tune_allocator();  // before any work: see core/allocator.hpp
   CLI::App app{"antpose: antenna azimuth, downtilt and roll from a smartphone"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "antpose 0.1.0");

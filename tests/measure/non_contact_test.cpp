@@ -8,13 +8,13 @@ namespace {
 using registration::RegistrationVerdict;
 
 // Three panels of one model registered beside each other, 1 m apart along x.
-struct Fixture {
+struct Panels {
   NonContactSetup setup;
   std::vector<AntennaMeasurement> antennas;
 };
 
-Fixture three_panels() {
-  Fixture f;
+Panels three_panels() {
+  Panels f;
   model::AntennaModel panel;
   panel.name = "panel";
   panel.size_m = Vec3(0.3, 0.15, 1.2);

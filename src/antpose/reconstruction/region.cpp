@@ -478,8 +478,6 @@ ObjectAttempt reconstruct_object(const std::vector<PosedView>& views, const Refi
   std::vector<detail::ViewFeatures> features(n);
   // Weak radome texture: SIFT's contrast threshold lowered, small regions enlarged 2×.
   constexpr double kUpscale = 2.0, kContrast = 0.01;
-  features[roi_view] =
-      detail::detect_features(ref.image, {}, clipped, kSparseFeatures, kSparseMaxSide, intrinsics, kUpscale, kContrast);
   const auto frustum = frustum_samples(roi, Rr, tr, intrinsics, {0.5, 2.0, 8.0, options.max_depth_m});
   std::vector<detail::PairMatches> pairs;
   for (int v = 0; v < n; ++v) {
@@ -493,20 +491,32 @@ ObjectAttempt reconstruct_object(const std::vector<PosedView>& views, const Refi
   }
   if (pairs.empty())
     throw seen_by_too_few(ref.name, 1, "any of it inside the frame");
+  // Where each photo is searched: the region itself in its own photo; in the others, the bounding
+  // box of the frustum's projection (points behind the camera are skipped: the box is then
+  // conservative only when the frustum lies in front, the usual case).
+  std::vector<cv::Rect> areas(n);
+  areas[roi_view] = clipped;
+  for (const auto& pair : pairs) {
+    Box box;
+    for (const auto& p : frustum)
+      if (const auto uv = intrinsics.project(poses.R_camera_board[pair.view_b] * p + poses.t_camera_board[pair.view_b]))
+        box.add(*uv);
+    if (!box.empty()) areas[pair.view_b] = box.pixels() & image_rect;
+  }
+  // Every photo's features at once (the region's own too: its enlarged crop is the largest), then
+  // the matches.
+  cv::parallel_for_(cv::Range(0, n), [&](const cv::Range& r) {
+    for (int v = r.start; v < r.end; ++v)
+      if (!areas[v].empty())
+        features[v] = detail::detect_features(views[v].image, {}, areas[v], kSparseFeatures, kSparseMaxSide, intrinsics,
+                                              kUpscale, kContrast);
+  });
   cv::parallel_for_(cv::Range(0, int(pairs.size())), [&](const cv::Range& r) {
     for (int k = r.start; k < r.end; ++k) {
       const int v = pairs[k].view_b;
+      if (areas[v].empty()) continue;
       const Mat3& R = poses.R_camera_board[v];
       const Vec3& t = poses.t_camera_board[v];
-      // Bounding box of the frustum's projection (points behind the camera are skipped: the
-      // box is then conservative only when the frustum lies in front, the usual case).
-      Box box;
-      for (const auto& p : frustum)
-        if (const auto uv = intrinsics.project(R * p + t)) box.add(*uv);
-      if (box.empty()) continue;
-      const cv::Rect area = box.pixels() & image_rect;
-      features[v] = detail::detect_features(views[v].image, {}, area, kSparseFeatures, kSparseMaxSide, intrinsics,
-                                            kUpscale, kContrast);
       const Mat3 R_b_a = R * Rr.transpose();
       const Vec3 t_b_a = t - R_b_a * tr;
       const double tol = 2.0 / std::min({1.0, features[roi_view].scale, features[v].scale});
