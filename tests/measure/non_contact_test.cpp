@@ -60,5 +60,46 @@ TEST(SettledNeighbours, RefusedAndModelFreeAntennasAreNotKnown) {
   EXPECT_TRUE(settled_neighbours(f.antennas, f.setup, 1).empty());
 }
 
+reconstruction::Mast pole_at(double x, double y, double radius = 0.05) {
+  reconstruction::Mast m;
+  m.axis_point_board = Vec3(x, y, 8.0);  // the height along the axis does not matter
+  m.up_board = Vec3::UnitZ();
+  m.radius_m = radius;
+  return m;
+}
+
+TEST(NeighboursMast, AMastFoundForAPanelBesideItWithinReachIsItsToo) {
+  auto f = three_panels();
+  f.antennas[2].mast = pole_at(1.6, 0.5);  // 0.78 m from panel 1, 1.68 m from panel 0
+  const auto adopted = neighbours_mast(f.antennas, f.setup, 1, Vec3::UnitZ(), 1.2);
+  ASSERT_TRUE(adopted.has_value());
+  EXPECT_TRUE(adopted->axis_point_board.isApprox(Vec3(1.6, 0.5, 8.0)));
+  EXPECT_FALSE(neighbours_mast(f.antennas, f.setup, 0, Vec3::UnitZ(), 1.2).has_value());  // beyond reach
+  EXPECT_FALSE(
+      neighbours_mast(f.antennas, f.setup, 2, Vec3::UnitZ(), 1.2).has_value());  // its own is not a neighbour's
+}
+
+TEST(NeighboursMast, TheNearestClearOfThePanelIsTaken) {
+  auto f = three_panels();
+  f.antennas[0].mast = pole_at(0.5, -0.6);  // 0.78 m from panel 1
+  f.antennas[2].mast = pole_at(1.3, 0.4);   // 0.5 m from panel 1: nearer
+  EXPECT_TRUE(
+      neighbours_mast(f.antennas, f.setup, 1, Vec3::UnitZ(), 1.2)->axis_point_board.isApprox(Vec3(1.3, 0.4, 8.0)));
+  // A pole through the panel's own box is not one it hangs on.
+  f.antennas[2].mast = pole_at(1.1, 0.05);
+  EXPECT_TRUE(
+      neighbours_mast(f.antennas, f.setup, 1, Vec3::UnitZ(), 1.2)->axis_point_board.isApprox(Vec3(0.5, -0.6, 8.0)));
+}
+
+TEST(NeighboursMast, ARefusedAntennasMastAndAModelFreeTargetTakeNone) {
+  auto f = three_panels();
+  f.antennas[2].mast = pole_at(1.6, 0.5);
+  f.antennas[2].error = "refused";
+  EXPECT_FALSE(neighbours_mast(f.antennas, f.setup, 1, Vec3::UnitZ(), 1.2).has_value());
+  f.antennas[2].error.reset();
+  f.setup.models.clear();  // model-free: no box to hang
+  EXPECT_FALSE(neighbours_mast(f.antennas, f.setup, 1, Vec3::UnitZ(), 1.2).has_value());
+}
+
 }  // namespace
 }  // namespace antpose::measure

@@ -92,7 +92,9 @@ void measure_jointly(std::vector<AntennaMeasurement>& antennas, const NonContact
       if (neighbours.empty()) continue;
       AntennaMeasurement again;
       again.roi = antennas[k].roi, again.region = antennas[k].region, again.region_view = antennas[k].region_view;
-      again.mast = antennas[k].mast;
+      again.mast = antennas[k].mast
+                       ? antennas[k].mast
+                       : neighbours_mast(antennas, setup, k, context.up_board, options.antenna.mast_search.reach_m);
       again.warnings = again.region.warnings;
       report(options, fmt::format("antenna {}: with its neighbours known", k + 1), 0, 1);
       measure_antenna(again, model, context, neighbours, options.antenna, antennas[k].registration_candidates);
@@ -145,6 +147,25 @@ std::vector<KnownBox> settled_neighbours(const std::vector<AntennaMeasurement>& 
     out.push_back({a.T_board_antenna(), setup.model_for(j)->size_m});
   }
   return out;
+}
+
+std::optional<reconstruction::Mast> neighbours_mast(const std::vector<AntennaMeasurement>& antennas,
+                                                    const NonContactSetup& setup, std::size_t k, const Vec3& up_board,
+                                                    double reach_m) {
+  const auto* model = setup.model_for(k);
+  if (!model || k >= antennas.size()) return std::nullopt;
+  const Vec3 up = up_board.normalized();
+  const auto horizontal = [&](const Vec3& v) { return Vec3(v - up * up.dot(v)); };
+  const double footprint = 0.5 * model->size_m.head<2>().norm();
+  std::optional<reconstruction::Mast> nearest;
+  double best = reach_m;
+  for (std::size_t j = 0; j < antennas.size(); ++j) {
+    const auto& a = antennas[j];
+    if (j == k || a.error || !a.mast) continue;
+    const double d = horizontal(a.mast->axis_point_board - antennas[k].p_board_antenna).norm();
+    if (d <= best && d > footprint + a.mast->radius_m) best = d, nearest = a.mast;
+  }
+  return nearest;
 }
 
 OptionProblems NonContactOptions::Check() const {

@@ -90,6 +90,15 @@ NonContactResult measure_non_contact(const Capture& capture, const NonContactSet
 std::vector<KnownBox> settled_neighbours(const std::vector<AntennaMeasurement>& antennas, const NonContactSetup& setup,
                                          std::size_t k);
 
+/// The mast antenna k may hang on where its own photos confirmed none: the nearest found for
+/// another measured antenna of the capture whose axis lies within `reach_m` of k's centre and
+/// clear of k's box (horizontally). Panels side by side hang on one structure, and where one
+/// panel's neighbours hide the foot of its mast in the photos, another panel may show it.
+/// nullopt where no other antenna's mast stands there.
+std::optional<reconstruction::Mast> neighbours_mast(const std::vector<AntennaMeasurement>& antennas,
+                                                    const NonContactSetup& setup, std::size_t k, const Vec3& up_board,
+                                                    double reach_m);
+
 /// The JSON of the command (docs/non-contact.md): per antenna azimuth_magnetic_deg,
 /// azimuth_true_deg (null without a site), downtilt_deg, roll_deg, uncertainty_deg {azimuth,
 /// downtilt, roll} and its budget by source (uncertainty_budget_deg), verdict, fit_rmse_m,
