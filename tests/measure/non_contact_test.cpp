@@ -71,34 +71,54 @@ reconstruction::Mast pole_at(double x, double y, double radius = 0.05) {
 TEST(NeighboursMast, AMastFoundForAPanelBesideItWithinReachIsItsToo) {
   auto f = three_panels();
   f.antennas[2].mast = pole_at(1.6, 0.5);  // 0.78 m from panel 1, 1.68 m from panel 0
-  const auto adopted = neighbours_mast(f.antennas, f.setup, 1, Vec3::UnitZ(), 1.2);
+  const auto adopted = neighbours_mast(f.antennas, f.setup, 1, 1.2);
   ASSERT_TRUE(adopted.has_value());
   EXPECT_TRUE(adopted->axis_point_board.isApprox(Vec3(1.6, 0.5, 8.0)));
-  EXPECT_FALSE(neighbours_mast(f.antennas, f.setup, 0, Vec3::UnitZ(), 1.2).has_value());  // beyond reach
-  EXPECT_FALSE(
-      neighbours_mast(f.antennas, f.setup, 2, Vec3::UnitZ(), 1.2).has_value());  // its own is not a neighbour's
+  EXPECT_FALSE(neighbours_mast(f.antennas, f.setup, 0, 1.2).has_value());  // beyond reach
+  EXPECT_FALSE(neighbours_mast(f.antennas, f.setup, 2, 1.2).has_value());  // its own is not a neighbour's
 }
 
 TEST(NeighboursMast, TheNearestClearOfThePanelIsTaken) {
   auto f = three_panels();
   f.antennas[0].mast = pole_at(0.5, -0.6);  // 0.78 m from panel 1
   f.antennas[2].mast = pole_at(1.3, 0.4);   // 0.5 m from panel 1: nearer
-  EXPECT_TRUE(
-      neighbours_mast(f.antennas, f.setup, 1, Vec3::UnitZ(), 1.2)->axis_point_board.isApprox(Vec3(1.3, 0.4, 8.0)));
+  EXPECT_TRUE(neighbours_mast(f.antennas, f.setup, 1, 1.2)->axis_point_board.isApprox(Vec3(1.3, 0.4, 8.0)));
   // A pole through the panel's own box is not one it hangs on.
   f.antennas[2].mast = pole_at(1.1, 0.05);
-  EXPECT_TRUE(
-      neighbours_mast(f.antennas, f.setup, 1, Vec3::UnitZ(), 1.2)->axis_point_board.isApprox(Vec3(0.5, -0.6, 8.0)));
+  EXPECT_TRUE(neighbours_mast(f.antennas, f.setup, 1, 1.2)->axis_point_board.isApprox(Vec3(0.5, -0.6, 8.0)));
+}
+
+TEST(FrontBackMasts, OnlyAnAntennaLeftOpenWithoutItsOwnMastTakesItsNeighbours) {
+  auto f = three_panels();
+  f.antennas[1].mast = pole_at(0.9, 0.6);
+  f.antennas[0].verdict = RegistrationVerdict::kFrontBackOpen;
+  f.antennas[0].error = "front and back cannot be told apart";
+  f.antennas[2].verdict = RegistrationVerdict::kFrontBackOpen;
+  f.antennas[2].mast = pole_at(2.0, 0.7);  // its own, which did not decide
+  const auto masts = front_back_masts(f.antennas, f.setup, 2.0);
+  ASSERT_EQ(masts.size(), 3u);
+  ASSERT_TRUE(masts[0].has_value());
+  EXPECT_TRUE(masts[0]->axis_point_board.isApprox(Vec3(0.9, 0.6, 8.0)));
+  EXPECT_FALSE(masts[1].has_value());                                       // decided
+  EXPECT_FALSE(masts[2].has_value());                                       // has its own
+  EXPECT_FALSE(front_back_masts(f.antennas, f.setup, 0.5)[0].has_value());  // beyond reach
+}
+
+TEST(NeighboursMast, ANegativeReachIsRefusedByTheOptionsCheck) {
+  NonContactOptions o;
+  EXPECT_TRUE(o.Check().ok());
+  o.shared_mast_reach_m = -0.5;
+  EXPECT_FALSE(o.Check().ok());
 }
 
 TEST(NeighboursMast, ARefusedAntennasMastAndAModelFreeTargetTakeNone) {
   auto f = three_panels();
   f.antennas[2].mast = pole_at(1.6, 0.5);
   f.antennas[2].error = "refused";
-  EXPECT_FALSE(neighbours_mast(f.antennas, f.setup, 1, Vec3::UnitZ(), 1.2).has_value());
+  EXPECT_FALSE(neighbours_mast(f.antennas, f.setup, 1, 1.2).has_value());
   f.antennas[2].error.reset();
   f.setup.models.clear();  // model-free: no box to hang
-  EXPECT_FALSE(neighbours_mast(f.antennas, f.setup, 1, Vec3::UnitZ(), 1.2).has_value());
+  EXPECT_FALSE(neighbours_mast(f.antennas, f.setup, 1, 1.2).has_value());
 }
 
 }  // namespace

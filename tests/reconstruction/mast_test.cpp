@@ -197,5 +197,18 @@ TEST(Mast, HoldsThePointsOnItsSurfaceAndInsideOverItsExtent) {
   EXPECT_TRUE(on_mast(mast, at(0.24, 0.0), 0.05));
 }
 
+// Distances across the axis: a point's height along it does not count.
+TEST(Mast, MeasuresDistancesAcrossItsAxis) {
+  Mast mast;
+  mast.axis_point_board = Vec3(1.0, 2.0, 3.0);
+  mast.up_board = Vec3(0.0, 0.6, 0.8);
+  mast.radius_m = 0.2;
+  const Vec3 out = mast.up_board.cross(Vec3::UnitX());
+  const Vec3 p = mast.axis_point_board + 0.5 * out + 4.0 * mast.up_board;
+  EXPECT_NEAR(distance_from_axis(mast, p), 0.5, 1e-12);
+  EXPECT_NEAR(distance_from_surface(mast, p), 0.3, 1e-12);
+  EXPECT_NEAR(distance_from_surface(mast, mast.axis_point_board - 7.0 * mast.up_board), 0.2, 1e-12);  // inside
+}
+
 }  // namespace
 }  // namespace antpose::reconstruction

@@ -163,6 +163,39 @@ void apply_registration(AntennaMeasurement& m, const model::AntennaModel& model,
   explain_verdict(m, r, c);
 }
 
+// The source of the budget that limits one angle most (`angle` reads its σ from a share).
+template <class Angle>
+const SigmaShare* largest_share(const AntennaAttitudeResult& a, const Angle& angle) {
+  const SigmaShare* best = nullptr;
+  for (const auto& s : a.budget)
+    if (!best || angle(s.sigma) > angle(best->sigma)) best = &s;
+  return best;
+}
+
+}  // namespace
+
+std::optional<std::string> imprecision_warning(const AntennaAttitudeResult& a, const AntennaOptions& o) {
+  const auto azimuth = [](const AttitudeSigma& s) { return s.azimuth.value_or(0.0); };
+  const auto downtilt = [](const AttitudeSigma& s) { return s.downtilt; };
+  std::string wide;
+  const SigmaShare* limit = nullptr;
+  if (a.sigma.azimuth && rad2deg(*a.sigma.azimuth) > o.warn_sigma_azimuth_deg)
+    wide = fmt::format("the azimuth to ±{:.1f}°", rad2deg(*a.sigma.azimuth)), limit = largest_share(a, azimuth);
+  if (rad2deg(a.sigma.downtilt) > o.warn_sigma_downtilt_deg) {
+    wide += fmt::format("{}the downtilt to ±{:.1f}°", wide.empty() ? "" : " and ", rad2deg(a.sigma.downtilt));
+    if (!limit) limit = largest_share(a, downtilt);
+  }
+  if (wide.empty() || !limit) return std::nullopt;
+  const bool compass = limit->source == "board attitude in the world";
+  return fmt::format(
+      "these photos fix {} (1σ, mostly from the {}): too wide to tell a right antenna from a wrong one; {}", wide,
+      limit->source,
+      compass ? "take the photos where the compass agrees along the walk, away from steel"
+              : "photograph the antenna from nearer, at a higher resolution or over a wider arc");
+}
+
+namespace {
+
 void measure_model_free(AntennaMeasurement& m, const CaptureContext& c, const AntennaOptions& o) {
   std::vector<Vec3> viewpoints;
   for (const auto& v : c.poses->views) viewpoints.push_back(camera::camera_centre(v.R_camera_board, v.t_camera_board));
@@ -208,6 +241,8 @@ OptionProblems AntennaOptions::Check() const {
             "clearance ≥ 0, stretch > 0");
   p.require(mast_points_share > 0 && mast_points_share <= 1, "mast_points_share", "in (0, 1]");
   p.require(reach_m > 0, "reach_m", "positive");
+  p.require(warn_sigma_azimuth_deg > 0 && warn_sigma_downtilt_deg > 0, "warn_sigma_azimuth_deg, warn_sigma_downtilt_deg",
+            "positive");
   p.require(min_viewing_span_deg >= 0 && warn_viewing_span_deg >= min_viewing_span_deg,
             "min_viewing_span_deg, warn_viewing_span_deg", "0 ≤ refusal ≤ warning");
   p.require(region.min_points >= 1, "region.min_points", "at least 1");
@@ -315,6 +350,7 @@ void measure_antenna(AntennaMeasurement& m, const model::AntennaModel* model, co
   }
   m.attitude = antenna_attitude(*c.board, m.R_board_antenna, m.cov_board, *c.site);
   if (!m.rivals_board.empty()) widen_for_rivals(m.attitude, m.R_board_antenna, m.rivals_board, *c.board);
+  if (auto w = imprecision_warning(m.attitude, o)) m.warnings.push_back(std::move(*w));
 }
 
 }  // namespace antpose::measure

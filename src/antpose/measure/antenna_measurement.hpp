@@ -62,6 +62,11 @@ struct AntennaOptions {
   double warn_rmse_m = 0.015;                     // their RMS distance above this: a poor fit
   double warn_fitness = 0.5;                      // a share of the region's points explained below this: a warning
   double warn_dilation_yaw_sigma_deg = 1.0;
+  /// An answer whose σ reaches what an audit counts as a wrong reading (3° of azimuth, 1° of
+  /// downtilt) cannot tell a right antenna from a wrong one: a warning names the σ, what limits it
+  /// and what would narrow it.
+  double warn_sigma_azimuth_deg = 3.0;
+  double warn_sigma_downtilt_deg = 1.0;
   OptionProblems Check() const;
 };
 
@@ -115,10 +120,15 @@ reconstruction::RegionReconstruction antenna_region(const CaptureContext& captur
                                                     const AntennaOptions& options,
                                                     const reconstruction::Progress& progress = {});
 
+/// The warning of AntennaOptions::warn_sigma_azimuth_deg and warn_sigma_downtilt_deg for an
+/// attitude whose σ reaches them, naming the source of its budget that limits it most; nullopt
+/// where both angles are narrower.
+std::optional<std::string> imprecision_warning(const AntennaAttitudeResult& attitude, const AntennaOptions& options);
+
 /// Registers `model` (nullptr: the model-free fit) to the region with `neighbours` known, and
 /// reads the attitude. `previous`: an earlier registration's candidates, judged again beside a new
 /// outline search instead of every strategy; `m.mast`, where set, is known from the start (found
-/// by that registration) and sought again beside the new pose. Sets `m.error` where no pose is
+/// by that registration, or a neighbour's) and sought again beside the new pose. Sets `m.error` where no pose is
 /// found.
 void measure_antenna(AntennaMeasurement& m, const model::AntennaModel* model, const CaptureContext& capture,
                      const std::vector<KnownBox>& neighbours, const AntennaOptions& options,

@@ -79,6 +79,22 @@ AntennaMeasurement measure_alone(std::size_t k, std::size_t shot, const NonConta
   return m;
 }
 
+// Antenna k measured once more from its region and its earlier candidates, with `mast` and
+// `neighbours` known.
+AntennaMeasurement remeasured(std::size_t k, const AntennaMeasurement& before, std::optional<reconstruction::Mast> mast,
+                              const std::vector<KnownBox>& neighbours, const NonContactSetup& setup,
+                              const CaptureContext& context, const NonContactOptions& options,
+                              const std::string& stage) {
+  AntennaMeasurement again;
+  again.roi = before.roi, again.region = before.region, again.region_view = before.region_view;
+  again.mast = std::move(mast);
+  again.warnings = again.region.warnings;
+  report(options, fmt::format("antenna {}: {}", k + 1, stage), 0, 1);
+  measure_antenna(again, setup.model_for(k), context, neighbours, options.antenna, before.registration_candidates);
+  report(options, fmt::format("antenna {}: {}", k + 1, stage), 1, 1);
+  return again;
+}
+
 // The antennas again, each with the others as registered known (their boxes in the photos, their
 // points): a neighbour 0.3 m away is then explained by its own model.
 void measure_jointly(std::vector<AntennaMeasurement>& antennas, const NonContactSetup& setup,
@@ -86,23 +102,28 @@ void measure_jointly(std::vector<AntennaMeasurement>& antennas, const NonContact
   for (int round = 0; round < options.joint_rounds; ++round) {
     std::vector<AntennaMeasurement> next = antennas;
     for (std::size_t k = 0; k < antennas.size(); ++k) {
-      const auto* model = setup.model_for(k);
-      if (!model || antennas[k].region.rois.empty()) continue;
+      if (!setup.model_for(k) || antennas[k].region.rois.empty()) continue;
       const auto neighbours = settled_neighbours(antennas, setup, k);
       if (neighbours.empty()) continue;
-      AntennaMeasurement again;
-      again.roi = antennas[k].roi, again.region = antennas[k].region, again.region_view = antennas[k].region_view;
-      again.mast = antennas[k].mast
-                       ? antennas[k].mast
-                       : neighbours_mast(antennas, setup, k, context.up_board, options.antenna.mast_search.reach_m);
-      again.warnings = again.region.warnings;
-      report(options, fmt::format("antenna {}: with its neighbours known", k + 1), 0, 1);
-      measure_antenna(again, model, context, neighbours, options.antenna, antennas[k].registration_candidates);
-      report(options, fmt::format("antenna {}: with its neighbours known", k + 1), 1, 1);
-      next[k] = std::move(again);
+      auto mast =
+          antennas[k].mast ? antennas[k].mast : neighbours_mast(antennas, setup, k, options.shared_mast_reach_m);
+      next[k] =
+          remeasured(k, antennas[k], std::move(mast), neighbours, setup, context, options, "with its neighbours known");
     }
     antennas = std::move(next);
   }
+}
+
+// The antennas front_back_masts names, measured once more with that mast.
+void settle_front_back(std::vector<AntennaMeasurement>& antennas, const NonContactSetup& setup,
+                       const CaptureContext& context, const NonContactOptions& options) {
+  const auto masts = front_back_masts(antennas, setup, options.shared_mast_reach_m);
+  std::vector<AntennaMeasurement> next = antennas;
+  for (std::size_t k = 0; k < antennas.size(); ++k)
+    if (masts[k])
+      next[k] = remeasured(k, antennas[k], masts[k], settled_neighbours(antennas, setup, k), setup, context, options,
+                           "with its neighbours' mast");
+  antennas = std::move(next);
 }
 
 // Two rectangles whose registrations settled on one panel: the one whose rectangle the panel
@@ -150,22 +171,28 @@ std::vector<KnownBox> settled_neighbours(const std::vector<AntennaMeasurement>& 
 }
 
 std::optional<reconstruction::Mast> neighbours_mast(const std::vector<AntennaMeasurement>& antennas,
-                                                    const NonContactSetup& setup, std::size_t k, const Vec3& up_board,
-                                                    double reach_m) {
+                                                    const NonContactSetup& setup, std::size_t k, double reach_m) {
   const auto* model = setup.model_for(k);
   if (!model || k >= antennas.size()) return std::nullopt;
-  const Vec3 up = up_board.normalized();
-  const auto horizontal = [&](const Vec3& v) { return Vec3(v - up * up.dot(v)); };
   const double footprint = 0.5 * model->size_m.head<2>().norm();
   std::optional<reconstruction::Mast> nearest;
   double best = reach_m;
   for (std::size_t j = 0; j < antennas.size(); ++j) {
     const auto& a = antennas[j];
     if (j == k || a.error || !a.mast) continue;
-    const double d = horizontal(a.mast->axis_point_board - antennas[k].p_board_antenna).norm();
+    const double d = reconstruction::distance_from_axis(*a.mast, antennas[k].p_board_antenna);
     if (d <= best && d > footprint + a.mast->radius_m) best = d, nearest = a.mast;
   }
   return nearest;
+}
+
+std::vector<std::optional<reconstruction::Mast>> front_back_masts(const std::vector<AntennaMeasurement>& antennas,
+                                                                  const NonContactSetup& setup, double reach_m) {
+  std::vector<std::optional<reconstruction::Mast>> out(antennas.size());
+  for (std::size_t k = 0; k < antennas.size(); ++k)
+    if (!antennas[k].mast && antennas[k].verdict == registration::RegistrationVerdict::kFrontBackOpen)
+      out[k] = neighbours_mast(antennas, setup, k, reach_m);
+  return out;
 }
 
 OptionProblems NonContactOptions::Check() const {
@@ -174,6 +201,7 @@ OptionProblems NonContactOptions::Check() const {
   p.nest("world", world.Check());
   p.nest("antenna", antenna.Check());
   p.require(joint_rounds >= 0 && joint_rounds <= 5, "joint_rounds", "0..5");
+  p.require(shared_mast_reach_m >= 0, "shared_mast_reach_m", "≥ 0 (0: no mast shared)");
   return p;
 }
 
@@ -213,6 +241,7 @@ NonContactResult measure_non_contact(const Capture& capture, const NonContactSet
   for (std::size_t k = 0; k < setup.rois.size(); ++k)
     result.antennas.push_back(measure_alone(k, roi_shots[k], setup, context, options));
   measure_jointly(result.antennas, setup, context, options);
+  if (options.joint_rounds > 0) settle_front_back(result.antennas, setup, context, options);
   refuse_shared_panels(result.antennas, setup, poses);
   return result;
 }

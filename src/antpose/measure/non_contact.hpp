@@ -9,7 +9,8 @@
 //              → registration: strategies, evidence, selection (registration/register_antenna.hpp)
 //              → attitude + covariance (antenna_attitude.hpp)
 //           ─► the antennas again with each other known (joint: a neighbour is explained by its
-//              own model, never taken for the target)
+//              own model, never taken for the target); one left with front and back open once
+//              more with the mast its neighbours found
 //           ─► result, JSON (non_contact_json.cpp), report (report.hpp)
 #pragma once
 
@@ -55,6 +56,11 @@ struct NonContactOptions {
   /// Rounds with the other antennas known (their boxes masked in the photos, their points left
   /// out); 0: each antenna alone.
   int joint_rounds = 1;
+  /// In the joint pass, an antenna whose own photos confirm no mast takes the nearest one found
+  /// for another antenna within this horizontal distance of its centre (neighbours_mast). Panels
+  /// side by side hang on one frame round one mast: a sector frame 2–3 m wide, held a few
+  /// decimetres out from the mast, puts its outer panels up to ~1.7 m from it.
+  double shared_mast_reach_m = 2.0;
   /// (stage, done, total) as the measurement advances.
   std::function<void(const std::string&, int, int)> progress;
   OptionProblems Check() const;
@@ -92,12 +98,18 @@ std::vector<KnownBox> settled_neighbours(const std::vector<AntennaMeasurement>& 
 
 /// The mast antenna k may hang on where its own photos confirmed none: the nearest found for
 /// another measured antenna of the capture whose axis lies within `reach_m` of k's centre and
-/// clear of k's box (horizontally). Panels side by side hang on one structure, and where one
+/// clear of k's box (across the mast's axis). Panels side by side hang on one structure, and where one
 /// panel's neighbours hide the foot of its mast in the photos, another panel may show it.
 /// nullopt where no other antenna's mast stands there.
 std::optional<reconstruction::Mast> neighbours_mast(const std::vector<AntennaMeasurement>& antennas,
-                                                    const NonContactSetup& setup, std::size_t k, const Vec3& up_board,
-                                                    double reach_m);
+                                                    const NonContactSetup& setup, std::size_t k, double reach_m);
+
+/// Per antenna, the mast it is measured once more with after the joint pass, or nullopt: an
+/// antenna left with front and back open and no mast of its own takes the one its neighbours found
+/// in that pass (neighbours_mast), where their neighbours were masked and a mast's foot may show
+/// only then; where the mast stands clearly behind one face, it decides them.
+std::vector<std::optional<reconstruction::Mast>> front_back_masts(const std::vector<AntennaMeasurement>& antennas,
+                                                                  const NonContactSetup& setup, double reach_m);
 
 /// The JSON of the command (docs/non-contact.md): per antenna azimuth_magnetic_deg,
 /// azimuth_true_deg (null without a site), downtilt_deg, roll_deg, uncertainty_deg {azimuth,

@@ -474,16 +474,19 @@ std::array<std::vector<cv::Point2f>, 2> mast_outline(const Mast& mast, const cam
   return lines;
 }
 
-double distance_from_surface(const Mast& mast, const Vec3& p_board) {
+double distance_from_axis(const Mast& mast, const Vec3& p_board) {
   const Horizontal h(mast.up_board);
-  return std::abs((h.of(p_board) - h.of(mast.axis_point_board)).norm() - mast.radius_m);
+  return (h.of(p_board) - h.of(mast.axis_point_board)).norm();
+}
+
+double distance_from_surface(const Mast& mast, const Vec3& p_board) {
+  return std::abs(distance_from_axis(mast, p_board) - mast.radius_m);
 }
 
 bool on_mast(const Mast& mast, const Vec3& p_board, double clearance_m) {
-  const Horizontal h(mast.up_board);
-  const double along = h.up.dot(p_board - mast.axis_point_board);
-  return (h.of(p_board) - h.of(mast.axis_point_board)).norm() <= mast.radius_m + clearance_m &&
-         along >= mast.low_m - clearance_m && along <= mast.high_m + clearance_m;
+  const double along = mast.up_board.normalized().dot(p_board - mast.axis_point_board);
+  return distance_from_axis(mast, p_board) <= mast.radius_m + clearance_m && along >= mast.low_m - clearance_m &&
+         along <= mast.high_m + clearance_m;
 }
 
 bool mast_in_front(const Mast& mast, const Vec3& camera_centre_board, const Vec3& p_board) {

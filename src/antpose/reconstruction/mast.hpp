@@ -97,6 +97,9 @@ std::array<std::vector<cv::Point2f>, 2> mast_outline(const Mast& mast, const cam
                                                      const Mat3& R_camera_board, const Vec3& t_camera_board,
                                                      int segments = 16);
 
+/// The distance of `p_board` from the mast's axis, across it (m).
+double distance_from_axis(const Mast& mast, const Vec3& p_board);
+
 /// The horizontal distance of `p_board` from the mast's surface (m, ≥ 0; inside it too).
 double distance_from_surface(const Mast& mast, const Vec3& p_board);
 
