@@ -241,8 +241,8 @@ OptionProblems AntennaOptions::Check() const {
             "clearance ≥ 0, stretch > 0");
   p.require(mast_points_share > 0 && mast_points_share <= 1, "mast_points_share", "in (0, 1]");
   p.require(reach_m > 0, "reach_m", "positive");
-  p.require(warn_sigma_azimuth_deg > 0 && warn_sigma_downtilt_deg > 0, "warn_sigma_azimuth_deg, warn_sigma_downtilt_deg",
-            "positive");
+  p.require(warn_sigma_azimuth_deg > 0 && warn_sigma_downtilt_deg > 0,
+            "warn_sigma_azimuth_deg, warn_sigma_downtilt_deg", "positive");
   p.require(min_viewing_span_deg >= 0 && warn_viewing_span_deg >= min_viewing_span_deg,
             "min_viewing_span_deg, warn_viewing_span_deg", "0 ≤ refusal ≤ warning");
   p.require(region.min_points >= 1, "region.min_points", "at least 1");
