@@ -11,7 +11,7 @@ AntennaAttitudeResult antenna_attitude(const BoardWorldAttitude& board, const Ma
   AntennaAttitudeResult r;
   r.R_world_antenna = board.R_world_board * R_board_antenna;
   r.covariance = board.covariance;
-  r.budget.push_back({"board attitude in the world", attitude_sigma(r.R_world_antenna, board.covariance)});
+  r.budget.push_back({kBoardAttitudeSource, attitude_sigma(r.R_world_antenna, board.covariance)});
   for (const auto& part : sources_board) {
     const Mat3 world = board.R_world_board * part.covariance * board.R_world_board.transpose();
     r.covariance += world;

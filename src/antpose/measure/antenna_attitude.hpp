@@ -21,6 +21,9 @@ namespace antpose::measure {
 /// The σ one source of uncertainty alone gives each angle (rad). The sources are independent and the
 /// propagation linear, so each angle's σ² is the sum of its shares' squares: the budget says what
 /// limits a measurement (the compass, the outline, the camera poses, a rival pose).
+/// The budget's share of the board's attitude in the world (the compass and the tilt).
+inline constexpr const char* kBoardAttitudeSource = "board attitude in the world";
+
 struct SigmaShare {
   std::string source;
   AttitudeSigma sigma;

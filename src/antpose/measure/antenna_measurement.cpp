@@ -186,7 +186,7 @@ std::optional<std::string> imprecision_warning(const AntennaAttitudeResult& a, c
     if (!limit) limit = largest_share(a, downtilt);
   }
   if (wide.empty() || !limit) return std::nullopt;
-  const bool compass = limit->source == "board attitude in the world";
+  const bool compass = limit->source == kBoardAttitudeSource;
   return fmt::format(
       "these photos fix {} (1σ, mostly from the {}): too wide to tell a right antenna from a wrong one; {}", wide,
       limit->source,
