@@ -138,6 +138,74 @@ TEST(PoseSelection, AMastBehindDecidesFrontAndBackWhateverTheDowntilt) {
   EXPECT_FALSE(s.front_back_open);
 }
 
+TEST(PoseSelection, MastBearingIsTheBoresightsAngleToTheMastEitherWay) {
+  reconstruction::Mast mast;
+  mast.axis_point_board = Vec3(0.0, 0.0, 5.0), mast.up_board = Vec3::UnitZ(), mast.radius_m = 0.2;
+  const Vec3 north(0.0, 0.9, 0.0);  // the panel 0.9 m north of the mast's axis
+  EXPECT_NEAR(*mast_bearing(mast, facing(0, north, {}).T_board_antenna), 0.0, 1e-9);
+  EXPECT_NEAR(*mast_bearing(mast, facing(180, north, {}).T_board_antenna), 0.0, 1e-9);
+  EXPECT_NEAR(rad2deg(*mast_bearing(mast, facing(-80, north, {}).T_board_antenna)), 80.0, 1e-9);
+  EXPECT_NEAR(rad2deg(*mast_bearing(mast, facing(110, north, {}).T_board_antenna)), 70.0, 1e-9);
+  // A downtilt does not change it: the bearing is taken across the mast's axis.
+  PoseCandidate tilted = facing(30, north, {});
+  tilted.T_board_antenna.linear() = tilted.T_board_antenna.linear() * rot_x(deg2rad(-12.0));
+  EXPECT_NEAR(rad2deg(*mast_bearing(mast, tilted.T_board_antenna)), 30.0, 1e-9);
+  EXPECT_FALSE(mast_bearing(mast, facing(0, Vec3(0.1, 0.0, 0.0), {}).T_board_antenna));  // within the mast
+}
+
+// A near-square box fits its outline a quarter turn off; the mast behind the panel contradicts
+// that pose, and the best pose that faces the mast becomes its rival though it scores worse. With
+// the mast behind the best, the same scores rule that pose out.
+TEST(PoseSelection, APoseSideOnToTheMastHasTheBestPoseFacingItAsARival) {
+  reconstruction::Mast mast;
+  mast.axis_point_board = Vec3::Zero(), mast.up_board = Vec3::UnitZ(), mast.radius_m = 0.25;
+  const Vec3 p(0.0, 1.0, 0.0);  // the panel 1 m north of the mast: its back faces south
+  const std::vector<double> good{0.20, 0.22, 0.19, 0.21, 0.20, 0.22}, worse{0.40, 0.43, 0.41, 0.42, 0.40, 0.44},
+      worst{0.60, 0.63, 0.61, 0.62, 0.60, 0.64};
+  const std::vector<PoseCandidate> side_on{facing(95, p, good), facing(75, p, worse), facing(3, p, worse),
+                                           facing(-20, p, worst)};
+  const std::vector<PoseEvidence> twins(side_on.size(), side({0.0, 0.0, 0.0, 0.0, 0.0, 0.0}));
+  ASSERT_TRUE(compare_shape(side_on[0].evidence, side_on[2].evidence, {}).decisive);
+  const Selection s = select_pose(side_on, twins, mast, {}, {});
+  EXPECT_EQ(s.best, 0u);
+  ASSERT_TRUE(s.mast_rival);
+  EXPECT_EQ(*s.mast_rival, 2u);  // at 75° the second turns a side to the mast too
+  EXPECT_TRUE(s.versus_mast_rival.decisive);
+  ASSERT_EQ(s.rivals.size(), 1u);
+  EXPECT_EQ(s.rivals[0], 2u);
+
+  std::vector<PoseCandidate> facing_mast = side_on;
+  facing_mast[0] = facing(175, p, good);  // the best's back to the mast: nothing to contradict
+  const Selection t = select_pose(facing_mast, twins, mast, {}, {});
+  EXPECT_EQ(t.best, 0u);
+  EXPECT_FALSE(t.mast_rival);
+  EXPECT_TRUE(t.rivals.empty());
+  EXPECT_TRUE(t.turned);  // facing south, at its mast: turned round
+  EXPECT_EQ(t.front_back_cue, FrontBackCue::kMast);
+}
+
+// A candidate whose outline is too faint to be the answer is never the best, however it scores,
+// nor an ordinary rival; it is weighed only as the pose facing the mast.
+TEST(PoseSelection, AFaintOutlineIsOnlyEverTheMastsRival) {
+  reconstruction::Mast mast;
+  mast.axis_point_board = Vec3::Zero(), mast.up_board = Vec3::UnitZ(), mast.radius_m = 0.25;
+  const Vec3 p(0.0, 1.0, 0.0);
+  const std::vector<double> good{0.20, 0.22, 0.19, 0.21}, alike{0.21, 0.20, 0.22, 0.20};
+  std::vector<PoseCandidate> candidates{facing(95, p, good), facing(40, p, alike), facing(-4, p, alike)};
+  candidates[1].score = 0.1, candidates[2].score = 0.15;  // better than the best by score alone
+  candidates[1].faint_outline = candidates[2].faint_outline = true;
+  const std::vector<PoseEvidence> twins(candidates.size(), side({0.0, 0.0, 0.0, 0.0}));
+  const Selection s = select_pose(candidates, twins, mast, {}, {});
+  EXPECT_EQ(s.best, 0u);
+  ASSERT_TRUE(s.mast_rival);
+  EXPECT_EQ(*s.mast_rival, 1u);  // 40° from the mast's direction: not side-on, and the better score
+  EXPECT_EQ(s.rivals, std::vector<std::size_t>{1u});
+  EXPECT_FALSE(s.runner_up);
+  const Selection without_mast = select_pose(candidates, twins, std::nullopt, {}, {});
+  EXPECT_EQ(without_mast.best, 0u);
+  EXPECT_TRUE(without_mast.rivals.empty());
+}
+
 TEST(PoseSelection, WithoutACueFrontAndBackStayOpen) {
   PoseCandidate c = facing(10, Vec3::Zero(), {0.1, 0.1, 0.1});
   c.evidence.mount_outline = {0.32, 0.30, 0.33};
@@ -169,11 +237,11 @@ TEST(PoseSelection, UprightTurnsAnUpsideDownPoseAboutItsBoresight) {
 
 // Reports name every strategy, each by its own name.
 TEST(PoseSelection, EveryStrategyHasItsOwnName) {
-  const std::set<std::string> names{to_string(Strategy::kGiven),         to_string(Strategy::kOutlineSearch),
-                                    to_string(Strategy::kPointsStart),   to_string(Strategy::kPointsHeld),
-                                    to_string(Strategy::kTurned),        to_string(Strategy::kTurnedAndPlaced),
-                                    to_string(Strategy::kSlid)};
-  EXPECT_EQ(names.size(), 7u);
+  const std::set<std::string> names{to_string(Strategy::kGiven),       to_string(Strategy::kOutlineSearch),
+                                    to_string(Strategy::kPointsStart), to_string(Strategy::kPointsHeld),
+                                    to_string(Strategy::kTurned),      to_string(Strategy::kTurnedAndPlaced),
+                                    to_string(Strategy::kSlid),        to_string(Strategy::kFacingMast)};
+  EXPECT_EQ(names.size(), 8u);
   EXPECT_EQ(to_string(Strategy::kOutlineSearch), "outline search");
 }
 

@@ -99,6 +99,23 @@ TEST(YawTurns, TurnsAHalfTurnApartAreOne) {
   ASSERT_EQ(poses.size(), 2u) << "90° and −90° leave the same box, as 178° leaves it nearly; 140° stays";
 }
 
+// The turn to face a direction keeps the long axis and the centre, turns by at most a quarter
+// turn, and leaves the boresight (or its reverse) in the plane of the long axis and the direction.
+TEST(YawTurns, FacingTurnPutsAFaceTowardsTheDirection) {
+  const Iso3 T = isometry(rot_z(deg2rad(35.0)) * rot_x(deg2rad(-8.0)), Vec3(1.0, -2.0, 3.0));
+  const Vec3 z = T.linear().col(2);
+  for (const Vec3& direction : {Vec3(1.0, 0.2, 0.0), Vec3(-0.3, -1.0, 0.4), Vec3(0.0, 1.0, -0.1)}) {
+    const auto U = facing_turn(T, direction);
+    ASSERT_TRUE(U);
+    EXPECT_TRUE(U->translation().isApprox(T.translation()));
+    EXPECT_LT(angle_between(U->linear().col(2), z), 1e-9);
+    EXPECT_LE(rotation_distance(U->linear(), T.linear()), M_PI / 2 + 1e-9);
+    const Vec3 across = (direction - direction.dot(z) * z).normalized();
+    EXPECT_NEAR(std::abs(U->linear().col(1).dot(across)), 1.0, 1e-9) << direction.transpose();
+  }
+  EXPECT_FALSE(facing_turn(T, 2.0 * z));
+}
+
 TEST(YawTurns, OptionsAreChecked) {
   YawTurnOptions o;
   EXPECT_TRUE(o.Check().ok());

@@ -103,6 +103,22 @@ void explain_verdict(AntennaMeasurement& m, const registration::AntennaRegistrat
         side_view_azimuth_deg(m.R_board_antenna, *c.board));
     return;
   }
+  if (const auto& rival = r.selection.mast_rival; rival && m.mast) {
+    const Iso3& T = r.candidates[*rival].T_board_antenna;
+    const bool away = T.linear().col(1).dot(T.translation() - m.mast->axis_point_board) >= 0.0;
+    const auto a =
+        attitude_from_rotation(c.board->R_world_board * (away ? T.linear() : registration::turned_round(T.linear())));
+    const auto& v = r.selection.versus_mast_rival;
+    m.warnings.push_back(fmt::format(
+        "the registration is ambiguous: the pose whose outline fits the photos best turns a side face to the mast "
+        "found {:.1f} m away, and a panel hangs with its back to its mount; with its back to the mast it would face "
+        "magnetic azimuth {:.1f}° (downtilt {:+.1f}°), scored {:+.3f} ± {:.3f} against the first over {} units; "
+        "the σ of each angle covers both; photos from the antenna's side, where its brackets and mount show, would "
+        "settle it",
+        reconstruction::distance_from_axis(*m.mast, m.p_board_antenna), rad2deg(a.azimuth.value_or(0.0)),
+        rad2deg(a.downtilt), v.difference, v.standard_error, v.units));
+    return;
+  }
   if (r.verdict == registration::RegistrationVerdict::kAmbiguousShape && r.selection.runner_up) {
     const auto& v = *r.selection.runner_up;
     m.warnings.push_back(fmt::format(
@@ -123,6 +139,7 @@ void apply_registration(AntennaMeasurement& m, const model::AntennaModel& model,
   for (const auto& rival : r.near_rivals) m.rivals_board.push_back(rival.linear());
   m.verdict = r.verdict;
   m.runner_up = r.selection.runner_up;
+  if (r.selection.mast_rival) m.mast_rival = r.selection.versus_mast_rival;
   m.front_back = r.selection.front_back;
   m.front_back_cue = r.selection.front_back_cue;
   m.silhouette_rms_px = r.outline_rms_px;

@@ -81,6 +81,8 @@ struct AntennaMeasurement {
   std::vector<Mat3> rivals_board;            // other poses the evidence does not rule out
   registration::RegistrationVerdict verdict = registration::RegistrationVerdict::kUnique;
   std::optional<registration::Comparison> runner_up;  // the result against the best other pose
+  /// Where the result turns a side face to the mast: it against the best pose that faces the mast.
+  std::optional<registration::Comparison> mast_rival;
   std::optional<registration::Comparison> front_back;
   registration::FrontBackCue front_back_cue = registration::FrontBackCue::kNone;
   AntennaAttitudeResult attitude;

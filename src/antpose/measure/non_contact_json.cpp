@@ -99,6 +99,7 @@ nlohmann::json antenna_json(const AntennaMeasurement& m) {
   for (const auto& c : m.registration_candidates)
     poses.push_back({{"strategy", registration::to_string(c.strategy)},
                      {"score", c.score},
+                     {"faint_outline", c.faint_outline},
                      {"R_board_antenna", io::matrix_rows_json(c.T_board_antenna.linear())},
                      {"p_board_antenna_m",
                       {c.T_board_antenna.translation().x(), c.T_board_antenna.translation().y(),
@@ -107,6 +108,7 @@ nlohmann::json antenna_json(const AntennaMeasurement& m) {
                        {"poses", poses},
                        {"rivals", m.rivals_board.size()},
                        {"runner_up", comparison_json(m.runner_up)},
+                       {"mast_rival", comparison_json(m.mast_rival)},
                        {"front_back", comparison_json(m.front_back)},
                        {"front_back_cue", registration::to_string(m.front_back_cue)},
                        {"edge_radius_m", m.edge_radius_m ? nlohmann::json(*m.edge_radius_m) : nullptr},

@@ -8,18 +8,44 @@
 namespace antpose::registration {
 namespace {
 
-// Whether a mast stands clearly behind the pose: its boresight, across the mast's axis, within
-// `max_angle` of the direction from the axis to the panel's centre. nullopt where the mast cannot
-// tell (the panel beside it or on it, or side-on to it).
-std::optional<bool> faces_away_from(const reconstruction::Mast& mast, const Iso3& T_board_antenna, double max_angle) {
+// The direction from the mast's axis to the panel's centre and the pose's boresight, both across
+// the axis and of unit length; nullopt where the centre lies within the mast or the boresight runs
+// along it.
+std::optional<std::pair<Vec3, Vec3>> across_mast(const reconstruction::Mast& mast, const Iso3& T_board_antenna) {
   const Vec3 axis = mast.up_board.normalized();
   const auto across = [&](const Vec3& v) -> Vec3 { return v - v.dot(axis) * axis; };
   const Vec3 away = across(T_board_antenna.translation() - mast.axis_point_board);
   const Vec3 boresight = across(T_board_antenna.linear().col(1));
   if (away.norm() <= mast.radius_m || boresight.norm() < 1e-9) return std::nullopt;
-  const double cosine = away.normalized().dot(boresight.normalized());
+  return std::pair{away.normalized(), boresight.normalized()};
+}
+
+// Whether a mast stands clearly behind the pose: its boresight, across the mast's axis, within
+// `max_angle` of the direction from the axis to the panel's centre. nullopt where the mast cannot
+// tell (the panel beside it or on it, or side-on to it).
+std::optional<bool> faces_away_from(const reconstruction::Mast& mast, const Iso3& T_board_antenna, double max_angle) {
+  const auto directions = across_mast(mast, T_board_antenna);
+  if (!directions) return std::nullopt;
+  const double cosine = directions->first.dot(directions->second);
   if (cosine >= std::cos(max_angle)) return true;
   if (cosine <= -std::cos(max_angle)) return false;
+  return std::nullopt;
+}
+
+// Where the best candidate turns a side face to the mast, the best other candidate that does not
+// and whose box lies further than rival_min_deg from the best's: the mast and the photos disagree
+// (pose_selection.hpp).
+std::optional<std::size_t> mast_rival(const std::vector<PoseCandidate>& candidates,
+                                      const std::vector<std::size_t>& order, const reconstruction::Mast& mast,
+                                      const SelectionOptions& options) {
+  const Iso3& best = candidates[order.front()].T_board_antenna;
+  if (!side_on_to_mast(mast, best, options)) return std::nullopt;
+  for (std::size_t k = 1; k < order.size(); ++k) {
+    const Iso3& T = candidates[order[k]].T_board_antenna;
+    if (box_angle(T.linear(), best.linear()) > deg2rad(options.rival_min_deg) && mast_bearing(mast, T) &&
+        !side_on_to_mast(mast, T, options))
+      return order[k];
+  }
   return std::nullopt;
 }
 
@@ -61,6 +87,8 @@ std::string to_string(Strategy strategy) {
       return "turned and placed by the outline";
     case Strategy::kSlid:
       return "slid along its long axis";
+    case Strategy::kFacingMast:
+      return "turned to face the mast";
     case Strategy::kGiven:
       break;
   }
@@ -98,6 +126,17 @@ Iso3 upright(const Iso3& T_board_antenna, const Vec3& up_board) {
   return T;
 }
 
+std::optional<double> mast_bearing(const reconstruction::Mast& mast, const Iso3& T_board_antenna) {
+  const auto directions = across_mast(mast, T_board_antenna);
+  if (!directions) return std::nullopt;
+  return std::acos(std::min(1.0, std::abs(directions->first.dot(directions->second))));
+}
+
+bool side_on_to_mast(const reconstruction::Mast& mast, const Iso3& T_board_antenna, const SelectionOptions& options) {
+  const auto bearing = mast_bearing(mast, T_board_antenna);
+  return bearing && *bearing > deg2rad(options.mast_side_on_deg);
+}
+
 double boresight_angle(const Mat3& a, const Mat3& b) { return angle_between(a.col(1), b.col(1)); }
 
 double box_angle(const Mat3& a, const Mat3& b) {
@@ -107,7 +146,8 @@ double box_angle(const Mat3& a, const Mat3& b) {
 OptionProblems SelectionOptions::Check() const {
   OptionProblems p;
   p.require(rival_min_deg > 0 && rival_min_deg < 90, "rival_min_deg", "in (0, 90)");
-  p.require(mast_max_angle_deg > 0 && mast_max_angle_deg < 90, "mast_max_angle_deg", "in (0, 90)");
+  p.require(mast_max_angle_deg > 0 && mast_max_angle_deg <= mast_side_on_deg && mast_side_on_deg < 90,
+            "mast_max_angle_deg, mast_side_on_deg", "0 < mast_max_angle_deg ≤ mast_side_on_deg < 90");
   return p;
 }
 
@@ -120,13 +160,17 @@ Selection select_pose(const std::vector<PoseCandidate>& candidates, const std::v
   Selection s;
   std::vector<std::size_t> order(candidates.size());
   std::iota(order.begin(), order.end(), 0);
-  std::sort(order.begin(), order.end(),
-            [&](std::size_t a, std::size_t b) { return candidates[a].score < candidates[b].score; });
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    const auto& ca = candidates[a];
+    const auto& cb = candidates[b];
+    return ca.faint_outline != cb.faint_outline ? cb.faint_outline : ca.score < cb.score;
+  });
   s.best = order.front();
   const Mat3& R_best = candidates[s.best].T_board_antenna.linear();
   const double rival_min = deg2rad(options.rival_min_deg);
   for (std::size_t k = 1; k < order.size(); ++k) {
     const auto& c = candidates[order[k]];
+    if (c.faint_outline) continue;  // only ever the mast's rival
     const double angle = boresight_angle(c.T_board_antenna.linear(), R_best);
     if (angle >= M_PI - rival_min) continue;  // the winner turned round: front and back
     const Comparison versus = compare_shape(candidates[s.best].evidence, c.evidence, evidence);
@@ -140,6 +184,15 @@ Selection select_pose(const std::vector<PoseCandidate>& candidates, const std::v
     if (!versus.decisive || !ranks_first_at_every_weight(candidates[s.best].evidence, c.evidence, evidence))
       s.rivals.push_back(order[k]);
   }
+  if (mast)
+    if ((s.mast_rival = mast_rival(candidates, order, *mast, options))) {
+      s.versus_mast_rival = compare_shape(candidates[s.best].evidence, candidates[*s.mast_rival].evidence, evidence);
+      if (std::find(s.rivals.begin(), s.rivals.end(), *s.mast_rival) == s.rivals.end()) {
+        s.rivals.push_back(*s.mast_rival);
+        std::stable_sort(s.rivals.begin(), s.rivals.end(),
+                         [&](std::size_t a, std::size_t b) { return candidates[a].score < candidates[b].score; });
+      }
+    }
   // Front and back: the mast where it stands clearly behind one of the two, else the side units.
   const Iso3& T = candidates[s.best].T_board_antenna;
   if (mast)

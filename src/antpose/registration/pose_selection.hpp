@@ -21,6 +21,15 @@
 // them (a panel's back plate faces its mount); otherwise the side units (the vertical structure
 // on either side, the mount's points) decide where one side is decisively better; otherwise front
 // and back stay open.
+// A known mast also speaks to the shape, though it never decides it. A panel's back faces what it
+// hangs on: on a sector mount its arms run along its boresight, on a frame it hangs beside its
+// neighbours, the mast behind the frame up to about atan(offset / stand-off) off its back. A box
+// whose width and depth are alike shows nearly the same outline turned a quarter about its long
+// axis, and where the photos favour the turn that puts a side face to the mast, the two
+// disagree: the best candidate facing the mast (within `mast_side_on_deg`) is then a rival
+// however the scores compare, and the answer is ambiguous rather than confidently side-on. That
+// candidate may be one whose outline is too faint to be the answer itself (faint_outline): where
+// the side-on pose fits its outline only faintly too, the photos cannot outweigh the mast.
 // No prior on the sign of the downtilt: panels with uptilt exist.
 #pragma once
 
@@ -40,13 +49,14 @@ namespace antpose::registration {
 /// The strategy that proposed a candidate (register_antenna.hpp). The refinement keeps a pose the
 /// points placed where they placed it (kPointsHeld), also in a later registration.
 enum class Strategy {
-  kGiven,              // passed in by the caller
-  kOutlineSearch,      // outline_search.hpp
-  kPointsStart,        // global_start.hpp
-  kPointsHeld,         // a points' start kept where the points place it, its outline not descended
-  kTurned,             // yaw_turns.hpp
-  kTurnedAndPlaced,    // a turned start placed again by the outline
-  kSlid,               // axis_slide.hpp
+  kGiven,            // passed in by the caller
+  kOutlineSearch,    // outline_search.hpp
+  kPointsStart,      // global_start.hpp
+  kPointsHeld,       // a points' start kept where the points place it, its outline not descended
+  kTurned,           // yaw_turns.hpp
+  kTurnedAndPlaced,  // a turned start placed again by the outline
+  kSlid,             // axis_slide.hpp
+  kFacingMast,       // yaw_turns.hpp's facing_turn: turned about its long axis to face a known mast
 };
 std::string to_string(Strategy strategy);  // as reports name it, e.g. "outline search"
 
@@ -59,6 +69,9 @@ struct PoseCandidate {
   /// The panel's shape profiled at this pose (shape_fit.hpp), where it was: a later
   /// registration of the same antenna starts from that model and keeps the profile.
   std::shared_ptr<const ShapeFit> panel_shape;
+  /// Its outline meets the photos' edges too faintly to be the answer (register_antenna.hpp); it
+  /// is weighed only as the mast's rival (file comment).
+  bool faint_outline = false;
 };
 
 struct SelectionOptions {
@@ -66,6 +79,10 @@ struct SelectionOptions {
   /// The mast decides front and back where the boresight of one of the two lies within this of
   /// the direction from the mast to the panel (the other then faces the mast).
   double mast_max_angle_deg = 60.0;
+  /// A pose whose boresight, either way, lies further than this from the direction between a known
+  /// mast and the panel turns a side face to the mast (file comment). Above the largest angle a
+  /// frame puts between a panel's back and its mast.
+  double mast_side_on_deg = 70.0;
   OptionProblems Check() const;
 };
 
@@ -78,6 +95,10 @@ struct Selection {
   std::vector<std::size_t> rivals;       // shape rivals, best first
   std::vector<std::size_t> near_rivals;  // within rival_min_deg, not ruled out (file comment), best first
   std::optional<Comparison> runner_up;   // the best against the best distinct other candidate
+  /// Where the best turns a side face to the known mast: the best candidate that does not (also
+  /// among the rivals), and the best against it.
+  std::optional<std::size_t> mast_rival;
+  Comparison versus_mast_rival;
   FrontBackCue front_back_cue = FrontBackCue::kNone;
   Comparison front_back;         // the chosen side against the other (side units)
   bool front_back_open = false;  // no cue decided
@@ -100,6 +121,14 @@ Iso3 turned_round(const Iso3& T_board_antenna);
 /// towards the top end cap: ../shared/notes/antenna-model.md).
 Mat3 upright(const Mat3& R_board_antenna, const Vec3& up_board);
 Iso3 upright(const Iso3& T_board_antenna, const Vec3& up_board);
+
+/// The angle between the pose's boresight (y_a), either way, and the direction from the mast's axis
+/// to the panel's centre, both across the mast's axis: rad, in [0, π/2]. nullopt where the centre
+/// lies within the mast or the boresight runs along it.
+std::optional<double> mast_bearing(const reconstruction::Mast& mast, const Iso3& T_board_antenna);
+
+/// Whether the pose turns a side face to the mast: its mast_bearing beyond mast_side_on_deg.
+bool side_on_to_mast(const reconstruction::Mast& mast, const Iso3& T_board_antenna, const SelectionOptions& options);
 
 /// The angle between two poses' boresights (y_a), rad.
 double boresight_angle(const Mat3& R_board_a, const Mat3& R_board_b);

@@ -180,6 +180,23 @@ std::vector<PoseCandidate> turned_proposals(const std::vector<Refined>& kept, co
   return out;
 }
 
+// The best candidate turned to face a known mast (yaw_turns.hpp's facing_turn) where it turns a side
+// face to it (pose_selection.hpp) and no candidate stands there yet: the strategy "held axis with
+// the mast known". Where the outline favours the quarter turn, the mast's own is otherwise never
+// refined, and the selection could not weigh the two.
+std::optional<PoseCandidate> facing_mast_proposal(const std::vector<Refined>& kept, const AntennaScene& s,
+                                                  const RegisterOptions& o) {
+  if (!o.face_mast || !s.mast || kept.empty()) return std::nullopt;
+  const Iso3& best = kept.front().candidate.T_board_antenna;
+  if (!side_on_to_mast(*s.mast, best, o.selection)) return std::nullopt;
+  const auto T = facing_turn(best, best.translation() - s.mast->axis_point_board);
+  if (!T || std::any_of(kept.begin(), kept.end(), [&](const Refined& k) {
+        return same_place(*T, k.candidate.T_board_antenna, o.turns.min_turn_deg);
+      }))
+    return std::nullopt;
+  return PoseCandidate{*T, Strategy::kFacingMast, {}, 0.0, nullptr};
+}
+
 // The turned starts placed again by the outline at their own orientation (outline_search.hpp's
 // place_box_outlines): a turn about the candidate's centre keeps a centre that belongs to the
 // candidate's orientation, and where the two orientations' basins lie further apart than the
@@ -225,6 +242,7 @@ std::vector<Refined> refine_and_turn(const std::shared_ptr<const model::AntennaM
                                      const std::vector<PoseCandidate>& proposals, const RegisterOptions& o) {
   auto kept = distinct_in_rectangle(refine_all(shared, s, proposals, o), *shared, s, o);
   auto turned = turned_proposals(kept, s, o);
+  if (auto facing = facing_mast_proposal(kept, s, o)) turned.push_back(std::move(*facing));
   const auto placed = placed_turns(turned, kept, *shared, s, o);
   turned.insert(turned.end(), placed.begin(), placed.end());
   const auto slid = slid_proposals(kept, s, o);
@@ -293,10 +311,25 @@ void fit_shapes(std::vector<Refined>& kept, const AntennaScene& s, const Registe
 // true pose may fit its outline a little worse than a wrong one that meets a neighbour's or the
 // background's edges, and only the comparison of the two with its own noise (pose_selection.hpp)
 // may rule it out; a candidate cut here could never be the rival that makes the answer ambiguous.
-void keep_fitting_outlines(std::vector<Refined>& kept, const RegisterOptions& o) {
+// For that reason, where the best outline meets its edges at least faintly but turns a side face to
+// a known mast, the candidates that face the mast stay however faint their outline, marked to be
+// weighed only as the mast's rival (PoseCandidate::faint_outline): they fill the rectangle as the
+// best does, and the mast speaks for them (pose_selection.hpp).
+void keep_fitting_outlines(std::vector<Refined>& kept, const AntennaScene& s, const RegisterOptions& o) {
+  const auto best = std::min_element(
+      kept.begin(), kept.end(), [](const Refined& a, const Refined& b) { return a.outline.score < b.outline.score; });
+  const bool contradicted = s.mast && o.face_mast && best != kept.end() &&
+                            best->outline.score <= o.max_faint_outline_score &&
+                            side_on_to_mast(*s.mast, best->candidate.T_board_antenna, o.selection);
+  const auto facing_mast = [&](const Refined& k) {
+    return contradicted && mast_bearing(*s.mast, k.candidate.T_board_antenna) &&
+           !side_on_to_mast(*s.mast, k.candidate.T_board_antenna, o.selection);
+  };
   std::erase_if(kept, [&](const Refined& k) {
-    return k.outline.score > o.max_faint_outline_score || k.outline.views_used < o.min_outline_views;
+    return k.outline.views_used < o.min_outline_views ||
+           (k.outline.score > o.max_faint_outline_score && !facing_mast(k));
   });
+  for (auto& k : kept) k.candidate.faint_outline = k.outline.score > o.max_faint_outline_score;
 }
 
 // A rival's pose turned the way the result's front and back were decided: by the mast where it
@@ -354,10 +387,13 @@ AntennaRegistration select(const AntennaScene& s, std::vector<Refined> kept, con
     candidates.back().score = candidates.back().evidence.score(judge.options());
     twins.push_back(judge(turned_round(k.candidate.T_board_antenna)));
   }
-  const auto best_shape = static_cast<std::size_t>(
-      std::min_element(candidates.begin(), candidates.end(),
-                       [](const PoseCandidate& a, const PoseCandidate& b) { return a.score < b.score; }) -
-      candidates.begin());
+  const auto best_shape = static_cast<std::size_t>(std::min_element(candidates.begin(), candidates.end(),
+                                                                    [](const PoseCandidate& a, const PoseCandidate& b) {
+                                                                      return a.faint_outline != b.faint_outline
+                                                                                 ? b.faint_outline
+                                                                                 : a.score < b.score;
+                                                                    }) -
+                                                   candidates.begin());
   add_mount_outline(candidates[best_shape].evidence, twins[best_shape], kept[best_shape], s, o);
   AntennaRegistration out;
   out.found = true;
@@ -473,7 +509,7 @@ AntennaRegistration register_antenna(const model::AntennaModel& model, const Ant
   const auto shared = std::make_shared<const model::AntennaModel>(model);
   auto kept = refine_and_turn(shared, s, proposals, o);
   fit_shapes(kept, s, o);
-  keep_fitting_outlines(kept, o);
+  keep_fitting_outlines(kept, s, o);
   if (kept.empty()) {
     AntennaRegistration none;
     none.proposed = proposals.size();

@@ -3,8 +3,10 @@
 //   strategies ──► candidate poses ──► each refined by its outline in every photo
 //   (outline search: outline_search.hpp;          (silhouette.hpp); the best one turned about its
 //    the points' global start: global_start.hpp)   long axis (yaw_turns.hpp), each turn also placed
-//                                                  by the outline at its own orientation; the
-//                                                  best ones slid along it (axis_slide.hpp); each
+//                                                  by the outline at its own orientation, and
+//                                                  turned to face a known mast it turns a side
+//                                                  to; the best ones slid along it
+//                                                  (axis_slide.hpp); each
 //                                                  refined too; the best ones' shape (edges, end
 //                                                  caps) profiled with their pose (shape_fit.hpp);
 //                                                  the points' starts also kept as they lie
@@ -68,6 +70,7 @@ struct RegisterOptions {
   std::size_t refine_candidates = 6;  // of each strategy, best first
   YawTurnOptions turns;               // the best refined candidates turned about their long axis (yaw_turns.hpp)
   bool place_turns = true;            // each turned start also placed by the outline at its own orientation
+  bool face_mast = true;              // the best turned to face a known mast it turns a side to (facing_turn)
   AxisSlideOptions slide;             // the best refined candidates slid along their long axis (axis_slide.hpp)
   /// The points' starts also kept where the points place them, their outline not descended:
   /// where a faint stretch of the true outline lets the descent lay it on a crease, the descent

@@ -70,4 +70,17 @@ std::vector<Iso3> yaw_turns(const Iso3& T_board_antenna, const Vec3& outline_box
   return out;
 }
 
+std::optional<Iso3> facing_turn(const Iso3& T_board_antenna, const Vec3& direction_board) {
+  const Mat3& R = T_board_antenna.linear();
+  const Vec3 d = direction_board - direction_board.dot(R.col(2)) * R.col(2);
+  if (d.norm() < 1e-9 * std::max(1.0, direction_board.norm())) return std::nullopt;
+  // Turning by α moves the direction's angle from the boresight, φ, to φ + α (mirror_turns).
+  double turn = -std::atan2(d.dot(R.col(0)), d.dot(R.col(1)));
+  if (turn > M_PI / 2) turn -= M_PI;
+  if (turn < -M_PI / 2) turn += M_PI;
+  Iso3 T = T_board_antenna;
+  T.linear() = exp_so3(turn * R.col(2)) * R;
+  return T;
+}
+
 }  // namespace antpose::registration

@@ -12,11 +12,13 @@
 //  - A grid of turns (turns_deg) about the candidate's own long axis, spaced about a basin's width,
 //    for the basins no symmetry predicts (a face's inner edges, brackets and end caps lining up
 //    with the photo's edges at another yaw).
-// φ is taken for the mean direction to the photos. register_antenna refines and judges each start
-// like any other proposal.
+// φ is taken for the mean direction to the photos. A third start comes from outside the photos: a
+// known mast, which a panel's back faces (pose_selection.hpp), turns the box to face it
+// (facing_turn). register_antenna refines and judges each start like any other proposal.
 #pragma once
 
 #include <cstddef>
+#include <optional>
 #include <vector>
 
 #include "antpose/core/check.hpp"
@@ -45,5 +47,10 @@ std::vector<double> mirror_turns(const Iso3& T_board_antenna, const Vec3& outlin
 /// min_turn_deg of no turn or of a smaller one left out; smallest turn first.
 std::vector<Iso3> yaw_turns(const Iso3& T_board_antenna, const Vec3& outline_box_m,
                             const std::vector<Vec3>& viewpoints_board, const YawTurnOptions& options);
+
+/// `T_board_antenna` turned about its own long axis z_a, by at most a quarter turn, until its
+/// boresight or its reverse lies in the plane of z_a and `direction_board` (a face, not an edge,
+/// towards it). nullopt where the direction runs along z_a.
+std::optional<Iso3> facing_turn(const Iso3& T_board_antenna, const Vec3& direction_board);
 
 }  // namespace antpose::registration
