@@ -126,6 +126,10 @@ Iso3 upright(const Iso3& T_board_antenna, const Vec3& up_board) {
   return T;
 }
 
+bool ranks_before(const PoseCandidate& a, const PoseCandidate& b) {
+  return a.faint_outline != b.faint_outline ? b.faint_outline : a.score < b.score;
+}
+
 std::optional<double> mast_bearing(const reconstruction::Mast& mast, const Iso3& T_board_antenna) {
   const auto directions = across_mast(mast, T_board_antenna);
   if (!directions) return std::nullopt;
@@ -160,11 +164,8 @@ Selection select_pose(const std::vector<PoseCandidate>& candidates, const std::v
   Selection s;
   std::vector<std::size_t> order(candidates.size());
   std::iota(order.begin(), order.end(), 0);
-  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-    const auto& ca = candidates[a];
-    const auto& cb = candidates[b];
-    return ca.faint_outline != cb.faint_outline ? cb.faint_outline : ca.score < cb.score;
-  });
+  std::sort(order.begin(), order.end(),
+            [&](std::size_t a, std::size_t b) { return ranks_before(candidates[a], candidates[b]); });
   s.best = order.front();
   const Mat3& R_best = candidates[s.best].T_board_antenna.linear();
   const double rival_min = deg2rad(options.rival_min_deg);

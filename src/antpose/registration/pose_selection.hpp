@@ -74,6 +74,9 @@ struct PoseCandidate {
   bool faint_outline = false;
 };
 
+/// The selection's order: candidates that may be the answer first (not faint_outline), then by score.
+bool ranks_before(const PoseCandidate& a, const PoseCandidate& b);
+
 struct SelectionOptions {
   double rival_min_deg = 10.0;  // boresights closer than this are the same answer
   /// The mast decides front and back where the boresight of one of the two lies within this of

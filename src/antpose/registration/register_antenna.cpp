@@ -387,13 +387,8 @@ AntennaRegistration select(const AntennaScene& s, std::vector<Refined> kept, con
     candidates.back().score = candidates.back().evidence.score(judge.options());
     twins.push_back(judge(turned_round(k.candidate.T_board_antenna)));
   }
-  const auto best_shape = static_cast<std::size_t>(std::min_element(candidates.begin(), candidates.end(),
-                                                                    [](const PoseCandidate& a, const PoseCandidate& b) {
-                                                                      return a.faint_outline != b.faint_outline
-                                                                                 ? b.faint_outline
-                                                                                 : a.score < b.score;
-                                                                    }) -
-                                                   candidates.begin());
+  const auto best_shape = static_cast<std::size_t>(
+      std::min_element(candidates.begin(), candidates.end(), ranks_before) - candidates.begin());
   add_mount_outline(candidates[best_shape].evidence, twins[best_shape], kept[best_shape], s, o);
   AntennaRegistration out;
   out.found = true;
