@@ -73,6 +73,21 @@ TEST(MastSearch, AShortPoleFarAboveTheBoardIsFound) {
   EXPECT_LT(f.axis_offset_m, 0.03);
 }
 
+// A panel hanging with its foot a few decimetres above the roof the photos are taken from (a long
+// panel on a short rooftop pole): no stretch of the pole below it lies above the roof, so the pole
+// is sought above the panel alone.
+registration::fixture::SceneSpec foot_near_the_roof() {
+  registration::fixture::SceneSpec spec;
+  spec.antenna_height_m = 1.0, spec.below_m = -0.5;  // the foot 0.35 m above the roof, the phone 1.5 m
+  return spec;
+}
+
+TEST(MastSearch, APoleAboveAPanelWhoseFootNearsTheRoofIsFound) {
+  const Found f = find_in(foot_near_the_roof());
+  ASSERT_TRUE(f.mast);
+  EXPECT_LT(f.axis_offset_m, 0.03);
+}
+
 MountSides mount_sides(const SyntheticScene& s, const MastSearchOptions& options = {}) {
   const Vec3 size = model::parametric_panel({}).size_m;
   const Inputs in = inputs(s, size);
@@ -106,6 +121,14 @@ TEST(MastSearch, ThePoleBehindIsRefinedBetweenTheGridsNodes) {
   ASSERT_TRUE(sides.behind && sides.before);
   EXPECT_LT(axis_offset(sides.behind->cylinder, s.mast), 0.015);
   EXPECT_NEAR(sides.behind->cylinder.radius_m, spec.mast_radius_m, 0.008);
+  EXPECT_LT(sides.behind->cost + 0.2, sides.before->cost);
+}
+
+TEST(MastSearch, TheMountOfAPanelWhoseFootNearsTheRoofIsBehindIt) {
+  const SyntheticScene s = registration::fixture::make_scene(foot_near_the_roof());
+  const auto sides = mount_sides(s);
+  ASSERT_TRUE(sides.behind && sides.before);
+  EXPECT_LT(axis_offset(sides.behind->cylinder, s.mast), 0.03);
   EXPECT_LT(sides.behind->cost + 0.2, sides.before->cost);
 }
 

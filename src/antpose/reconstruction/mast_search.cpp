@@ -68,6 +68,7 @@ class CylinderCost {
 
  private:
   void add_line(std::size_t i, const Vec2& g, double low, double high, double& sum, std::size_t& measured) const {
+    if (!(high > low)) return;  // an empty stretch (none below the panel above the ground)
     const auto& v = views_[i];
     const auto a = K_.project(v.R_camera_board * frame_.point(g.x(), g.y(), low) + v.t_camera_board);
     const auto b = K_.project(v.R_camera_board * frame_.point(g.x(), g.y(), high) + v.t_camera_board);
@@ -159,7 +160,7 @@ bool in_search(const Grid& g, const Cylinder& c, const MastSearchOptions& o) {
 }
 
 // The grid scored over the stretches below and above the panel, and beside it where
-// `beside_panel`; nullopt where no stretch below it lies above the ground.
+// `beside_panel`; nullopt where none of them lies above the ground.
 std::optional<Grid> score_grid(const std::vector<PosedView>& views, const camera::CameraIntrinsics& K,
                                const Vec3& up_board, const Iso3& T_board_panel, const Vec3& size,
                                const std::vector<std::vector<std::vector<cv::Point2f>>>& occluders, bool beside_panel,
@@ -181,10 +182,16 @@ std::optional<Grid> score_grid(const std::vector<PosedView>& views, const camera
   for (const auto& v : views)
     lowest_camera =
         std::min(lowest_camera, f.up.dot(camera::camera_centre(v.R_camera_board, v.t_camera_board) - f.centre));
-  g.low = std::max(bottom - o.below_m, lowest_camera - o.hand_height_m), g.high = top + o.above_m;
-  if (!(g.low < bottom - o.gap_m)) return std::nullopt;
-  const std::array<std::pair<double, double>, 2> stretches{
-      std::pair{g.low, bottom - o.gap_m}, std::pair{beside_panel ? bottom - o.gap_m : top + o.gap_m, g.high}};
+  // A panel may hang with its foot near the roof the photos were taken from: then only the stretch
+  // above it (and beside it) shows its mount.
+  const double ground = lowest_camera - o.hand_height_m;
+  const std::pair<double, double> below{std::max(bottom - o.below_m, ground), bottom - o.gap_m};
+  const std::pair<double, double> upper{beside_panel ? std::max(bottom - o.gap_m, ground) : top + o.gap_m,
+                                        top + o.above_m};
+  const bool any_below = below.first < below.second;
+  if (!any_below && !(upper.first < upper.second)) return std::nullopt;
+  g.low = any_below ? below.first : upper.first, g.high = upper.second;
+  const std::array<std::pair<double, double>, 2> stretches{below, upper};
   g.cost = std::make_unique<const CylinderCost>(views, K, f, stretches,
                                                 search_maps(views, K, f, g.low, g.high, occluders, o), o);
   const CylinderCost& cost = *g.cost;
