@@ -371,11 +371,14 @@ PreparedViews prepare_views(const EdgeMesh& m, const std::vector<Pose>& poses, c
       for (int l = 0; l <= out.top; ++l) {
         cv::Mat gx = levels.gx[static_cast<std::size_t>(l)], gy = levels.gy[static_cast<std::size_t>(l)];
         if (with_mask) {
-          // The shared images stay as they are: this view's known objects are its own.
-          v.mask.push_back(level_mask(in, v.offset, gx.size(), l, options.mask_guard_px));
-          gx = gx.clone(), gy = gy.clone();
-          gx.setTo(0, v.mask.back());
-          gy.setTo(0, v.mask.back());
+          // The shared images stay as they are: this view's known objects are its own. Where none
+          // reaches the crop, the shared images serve unchanged (no copy).
+          const cv::Mat& mask = v.mask.emplace_back(level_mask(in, v.offset, gx.size(), l, options.mask_guard_px));
+          if (cv::countNonZero(mask) > 0) {
+            gx = gx.clone(), gy = gy.clone();
+            gx.setTo(0, mask);
+            gy.setTo(0, mask);
+          }
         }
         v.gx.push_back(gx);
         v.gy.push_back(gy);
