@@ -495,6 +495,25 @@ TEST(Silhouette, AMonotoneDescentWithTheAxisHeldKeepsANarrowPanelsOutline) {
   }
 }
 
+// The score a descent reports is the outline's score at the pose it ended on, whether the line
+// search kept it step by step (a monotone descent) or it is scored once at the end.
+TEST(Silhouette, TheReportedScoreIsTheOutlinesScoreWhereTheDescentEnded) {
+  const auto& s = narrow_panel_from_the_ground();
+  for (const int halvings : {-1, 3}) {
+    SilhouetteOptions options;
+    options.max_step_halvings = halvings;
+    SilhouetteOptions still = options;
+    still.max_iterations_per_level = 0;
+    for (const double yaw : {-6.0, 4.0}) {
+      const Iso3 start = perturbed(s.T_board_antenna, yaw, 1.0, Vec3(0.03, -0.02, 0.02));
+      const auto r = refine_by_silhouette(s.mesh_antenna, start, s.views, s.intrinsics, options);
+      ASSERT_GT(r.iterations, 0);
+      const double there = refine_by_silhouette(s.mesh_antenna, r.T_board_antenna, s.views, s.intrinsics, still).score;
+      EXPECT_NEAR(r.score, there, 1e-9) << "halvings " << halvings << ", yaw " << yaw;
+    }
+  }
+}
+
 // The brackets' outline runs into the arms that hold them, which the model lacks, so it is found
 // a pixel or two off; at the back plate's lever arm that can turn a narrow panel's yaw by
 // degrees, even from the truth as the start. With the model's box given, outline

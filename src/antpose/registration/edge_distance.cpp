@@ -6,6 +6,8 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "antpose/core/rounding.hpp"
+
 namespace antpose::registration {
 namespace {
 
@@ -87,8 +89,8 @@ int EdgeDistance::bin(const Vec2& normal) const {
 double EdgeDistance::distance(const Vec2& p_px, int b, EdgeLookup& status) const {
   status = EdgeLookup::kOutside;
   if (distance_.empty()) return 0.0;
-  const int x = static_cast<int>(std::lround((p_px.x() - area_.x) * scale_));
-  const int y = static_cast<int>(std::lround((p_px.y() - area_.y) * scale_));
+  const int x = round_half_away((p_px.x() - area_.x) * scale_);
+  const int y = round_half_away((p_px.y() - area_.y) * scale_);
   if (x < 0 || y < 0 || x >= mask_.cols || y >= mask_.rows) return 0.0;
   if (mask_.at<std::uint8_t>(y, x)) {
     status = EdgeLookup::kMasked;

@@ -13,8 +13,9 @@
 namespace antpose::registration {
 namespace {
 
-using detail::edge_cost, detail::EdgeMesh, detail::gather_all, detail::Gathered, detail::OutlineCounts, detail::Pose,
-    detail::prepare_views, detail::PreparedView, detail::PreparedViews, detail::Sample, detail::weld;
+using detail::edge_cost, detail::EdgeMesh, detail::gather_all, detail::Gathered, detail::GatherWhat,
+    detail::OutlineCounts, detail::Pose, detail::prepare_views, detail::PreparedView, detail::PreparedViews,
+    detail::Sample, detail::weld;
 
 using Vec6 = Eigen::Matrix<double, 6, 1>;
 using Mat6 = Eigen::Matrix<double, 6, 6>;
@@ -140,32 +141,36 @@ class Descender {
     if (monotone() && stages_.back().second > o.fine_search_px) stages_.emplace_back(0, o.fine_search_px);
   }
 
-  Gathered gather(const Pose& p, int level, double search_px, bool with_attachments = false) {
-    Gathered g = gather_all(m_, p, views_, K_, level, search_px, o_, with_attachments);
+  Gathered gather(const Pose& p, int level, double search_px, GatherWhat what = {}) {
+    Gathered g = gather_all(m_, p, views_, K_, level, search_px, o_, what);
     reached_middle_ = reached_middle_ || g.counts.reached_middle;
     return g;
   }
-  double full_score(const Pose& p) { return score(gather(p, 0, o_.fine_search_px), o_); }
+  double full_score(const Pose& p) { return score(gather(p, 0, o_.fine_search_px, {.jacobians = false}), o_); }
   bool reached_middle() const { return reached_middle_; }
 
   Descent descend(const Pose& start) {
     Descent d;
     d.pose = start;
-    for (const auto& [level, search] : stages_) descend_stage(d, level, search);
-    d.score = full_score(d.pose);
+    std::optional<double> scored;
+    for (const auto& [level, search] : stages_) scored = descend_stage(d, level, search);
+    d.score = scored ? *scored : full_score(d.pose);
     return d;
   }
 
  private:
   bool monotone() const { return o_.max_step_halvings >= 0; }
 
-  void descend_stage(Descent& d, int level, double search) {
+  // The stage's descent from d.pose; where it is checked, the score at the pose it ends on (kept
+  // with every step it takes), else nothing.
+  std::optional<double> descend_stage(Descent& d, int level, double search) {
     const double scale = std::ldexp(1.0, level);
     // Monotone at full resolution: Gauss–Newton re-associates the edges at every step, and nearer
     // a strong clutter edge than the panel's own it walks off the outline while each step looks
     // good to its own linearisation; the score (which ranks the starts) does not.
     const bool checked = monotone() && level == 0;
     double current = checked ? full_score(d.pose) : 0.0;
+    const auto ended = [&]() { return checked ? std::optional<double>(current) : std::nullopt; };
     d.converged = false;
     Vec6 previous_step = Vec6::Zero();
     for (int it = 0; it < o_.max_iterations_per_level; ++it) {
@@ -191,16 +196,17 @@ class Descender {
       if (swinging) *delta /= 2;
       if (checked && !lowers_score(d, *delta, current)) {  // nothing along Gauss–Newton's direction does: arrived
         d.converged = true;
-        return;
+        return ended();
       }
       d.pose.R = exp_so3(delta->head<3>()) * d.pose.R;
       d.pose.t += delta->tail<3>();
       previous_step = *delta;
       if (motion < 0.01 || swinging) {
         d.converged = true;
-        return;
+        return ended();
       }
     }
+    return ended();
   }
 
   // The step, halved up to max_step_halvings times until it lowers the score (a line search).
@@ -342,7 +348,7 @@ SilhouetteResult refine_prepared(const EdgeMesh& m, const Pose& start, const Pre
   }
 
   // Statistics and covariance at the solution (full resolution, fine search).
-  const Gathered g = descender.gather(best.pose, 0, options.fine_search_px, true);
+  const Gathered g = descender.gather(best.pose, 0, options.fine_search_px, {.attachments = true});
   result.search_reached_middle = descender.reached_middle();
   result.score_with_attachments = score(g, options, true);
   Normal n = normal_equations(g, 1.0, options);
@@ -416,7 +422,8 @@ std::vector<OutlineEvaluation> evaluate_outlines(const model::Mesh& mesh_antenna
   const double nan = std::numeric_limits<double>::quiet_NaN();
   std::vector<OutlineEvaluation> out;
   for (const Pose& pose : at) {
-    const Gathered g = gather_all(m, pose, ready.views, intrinsics, 0, options.fine_search_px, options);
+    const Gathered g =
+        gather_all(m, pose, ready.views, intrinsics, 0, options.fine_search_px, options, {.jacobians = false});
     OutlineEvaluation& e = out.emplace_back();
     for (std::size_t i = 0; i < views.size(); ++i) {
       const OutlineCounts& c = g.per_view_counts[i];

@@ -80,8 +80,16 @@ struct OutlineCounts {
 // A sample's cost in score(): its squared distance truncated at score_cutoff_px, 1 without an edge.
 double edge_cost(std::optional<double> r_px, const SilhouetteOptions& o);
 
+// What a gathering measures besides each sample's edge: its Jacobian (for the normal equations
+// and the covariance; a score needs only the edges) and the attachments' outline.
+struct GatherWhat {
+  bool jacobians = true;
+  bool attachments = false;
+};
+
 // Every photo's outer-contour samples at `level` with their edges found within ±`search_px`, and
-// the outline points counted; the attachments' outline measured only `with_attachments`.
+// the outline points counted; the attachments' outline measured only `what.attachments`. Without
+// `what.jacobians` the samples' J is left zero.
 struct Gathered {
   std::vector<std::vector<Sample>> per_view;
   std::vector<OutlineCounts> per_view_counts;
@@ -91,7 +99,7 @@ struct Gathered {
 
 Gathered gather_all(const EdgeMesh& m, const Pose& pose, const std::vector<PreparedView>& views,
                     const camera::CameraIntrinsics& K, int level, double search_px, const SilhouetteOptions& o,
-                    bool with_attachments = false);
+                    GatherWhat what = {});
 
 // The photos prepared for the outline of the model at `poses` (one or more close together): each
 // cropped (its ROI, or the union of the model's projected boxes plus a margin), as gradient

@@ -11,6 +11,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "antpose/camera/edge_search.hpp"
+#include "antpose/core/rounding.hpp"
 
 namespace antpose::registration::detail {
 
@@ -45,15 +46,11 @@ EdgeMesh weld(const model::Mesh& mesh) {
 
 namespace {
 
-// std::lround (half away from zero) inline: the mask look-ups below run once per pixel step of
-// every search line, where the libm call took 6 % of a measurement.
-int round_px(double v) { return static_cast<int>(v < 0.0 ? v - 0.5 : v + 0.5); }
-
 // Whether an outline point at `p` (full-resolution px) falls on the view's mask at `level`.
 bool masked(const PreparedView& v, int level, const Vec2& p) {
   if (v.mask.empty()) return false;
   const Vec2 q = (p - v.offset) / std::ldexp(1.0, level);
-  const int x = round_px(q.x()), y = round_px(q.y());
+  const int x = round_half_away(q.x()), y = round_half_away(q.y());
   const cv::Mat& m = v.mask[static_cast<std::size_t>(level)];
   return x >= 0 && y >= 0 && x < m.cols && y < m.rows && m.at<std::uint8_t>(y, x) != 0;
 }
@@ -121,7 +118,7 @@ struct ProjectionMask {
 
   Vec2 to_mask(const Vec2& p) const { return Vec2((p.x() - origin.x()) / ms, (p.y() - origin.y()) / ms); }
   bool inside(const Vec2& q) const {
-    const int x = round_px(q.x()), y = round_px(q.y());
+    const int x = round_half_away(q.x()), y = round_half_away(q.y());
     return x >= 0 && y >= 0 && x < mask.cols && y < mask.rows && mask.at<std::uint8_t>(y, x) != 0;
   }
 };
@@ -162,7 +159,7 @@ std::optional<ProjectionMask> project_model(const EdgeMesh& m, const Pose& pose,
         const auto p = project(K, v, A + (B - A) * (double(j) / n));
         if (!p) return std::nullopt;
         const Vec2 q = out.to_mask(*p) * 4.0;  // shift = 2: quarter-pixel vertices
-        poly.emplace_back(round_px(q.x()), round_px(q.y()));
+        poly.emplace_back(round_half_away(q.x()), round_half_away(q.y()));
       }
     }
     // A triangle's projection, its sides bowed by the distortion alone, is monotonic in y.
@@ -192,9 +189,9 @@ std::optional<Eigen::Matrix<double, 1, 6>> sample_jacobian(const camera::CameraI
 }
 
 // The outer contour samples of one view at `level` with their edge measurements; the
-// attachments' outline is measured only `with_attachments` (for score_with_attachments, once).
+// attachments' outline is measured only `what.attachments` (for score_with_attachments, once).
 void gather(const EdgeMesh& m, const Pose& pose, const PreparedView& v, const camera::CameraIntrinsics& K, int level,
-            double search_px, const SilhouetteOptions& o, bool with_attachments, std::vector<Sample>& out,
+            double search_px, const SilhouetteOptions& o, GatherWhat what, std::vector<Sample>& out,
             OutlineCounts& counts) {
   counts = {};
   if (!v.usable) return;
@@ -235,7 +232,7 @@ void gather(const EdgeMesh& m, const Pose& pose, const PreparedView& v, const ca
     for (int j = 0; j < n; ++j) {
       const double s = (j + 0.5) / n, ds = 0.25 / n;
       const bool attachment = !on_box(a_antenna + (b_antenna - a_antenna) * s);
-      if (attachment && !with_attachments) continue;
+      if (attachment && !what.attachments) continue;
       const Vec3 X = A + (B - A) * s;
       const auto p = project(K, v, X);
       const auto p0 = project(K, v, A + (B - A) * (s - ds));
@@ -279,10 +276,14 @@ void gather(const EdgeMesh& m, const Pose& pose, const PreparedView& v, const ca
         continue;
       }
       if (!edge) continue;
-      const auto J = sample_jacobian(K, v, pose, X, normal);
-      if (!J) continue;
+      Eigen::Matrix<double, 1, 6> J = Eigen::Matrix<double, 1, 6>::Zero();
+      if (what.jacobians) {
+        const auto dp = sample_jacobian(K, v, pose, X, normal);
+        if (!dp) continue;
+        J = *dp;
+      }
       const double depth = (v.R_cb * X + v.t_cb).z();
-      out.push_back({normal, *edge * scale, *J, static_cast<std::uint32_t>(ei), 0.5 * (K.fx + K.fy) / depth});
+      out.push_back({normal, *edge * scale, J, static_cast<std::uint32_t>(ei), 0.5 * (K.fx + K.fy) / depth});
     }
   }
 }
@@ -291,14 +292,14 @@ void gather(const EdgeMesh& m, const Pose& pose, const PreparedView& v, const ca
 
 Gathered gather_all(const EdgeMesh& m, const Pose& pose, const std::vector<PreparedView>& views,
                     const camera::CameraIntrinsics& K, int level, double search_px, const SilhouetteOptions& o,
-                    bool with_attachments) {
+                    GatherWhat what) {
   Gathered g;
   g.per_view.resize(views.size());
   auto& counts = g.per_view_counts;
   counts.resize(views.size());
   cv::parallel_for_(cv::Range(0, static_cast<int>(views.size())), [&](const cv::Range& r) {
     for (int i = r.start; i < r.end; ++i)
-      gather(m, pose, views[i], K, level, search_px, o, with_attachments, g.per_view[i], counts[i]);
+      gather(m, pose, views[i], K, level, search_px, o, what, g.per_view[i], counts[i]);
   });
   for (std::size_t i = 0; i < views.size(); ++i) {
     g.counts += counts[i];
