@@ -57,5 +57,14 @@ TEST(ImprecisionWarning, BadThresholdsAreRefusedByTheOptionsCheck) {
   EXPECT_FALSE(o.Check().ok());
 }
 
+TEST(AntennaOptions, ANegativeSameMastToleranceIsRefusedByTheCheck) {
+  AntennaOptions o;
+  EXPECT_TRUE(o.Check().ok());
+  o.same_mast_m = -0.01;
+  const auto problems = o.Check();
+  EXPECT_FALSE(problems.ok());
+  EXPECT_NE(problems.message().find("same_mast_m"), std::string::npos) << problems.message();
+}
+
 }  // namespace
 }  // namespace antpose::measure

@@ -177,13 +177,19 @@ TEST(Mast, FromPointsAloneIsTheCylinderTheyLieOn) {
   EXPECT_FALSE(mast_from_points(points, up, tall));
 }
 
-// On the mast: within the clearance of its surface or inside it, and of its extent along the axis.
-TEST(Mast, HoldsThePointsOnItsSurfaceAndInsideOverItsExtent) {
+// A mast of 0.2 m radius leaning away from the board's z axis, 3 m of it about (1, 2, 3).
+Mast leaning_mast() {
   Mast mast;
   mast.axis_point_board = Vec3(1.0, 2.0, 3.0);
   mast.up_board = Vec3(0.0, 0.6, 0.8);
   mast.radius_m = 0.2;
   mast.low_m = -1.0, mast.high_m = 2.0;
+  return mast;
+}
+
+// On the mast: within the clearance of its surface or inside it, and of its extent along the axis.
+TEST(Mast, HoldsThePointsOnItsSurfaceAndInsideOverItsExtent) {
+  const Mast mast = leaning_mast();
   const Vec3 out = mast.up_board.unitOrthogonal();
   const auto at = [&](double from_axis, double along) {
     return Vec3(mast.axis_point_board + from_axis * out + along * mast.up_board);
@@ -208,6 +214,33 @@ TEST(Mast, MeasuresDistancesAcrossItsAxis) {
   EXPECT_NEAR(distance_from_axis(mast, p), 0.5, 1e-12);
   EXPECT_NEAR(distance_from_surface(mast, p), 0.3, 1e-12);
   EXPECT_NEAR(distance_from_surface(mast, mast.axis_point_board - 7.0 * mast.up_board), 0.2, 1e-12);  // inside
+}
+
+// Found again: the same axis described from another point on it is the same mast; a shift of the
+// axis (at the antenna or a metre along), a tilt, another radius or another end is not.
+TEST(Mast, IsTheSameWhereFoundAgainWithinTheTolerance) {
+  const Mast a = leaning_mast();
+  const Vec3 antenna = a.axis_point_board + 0.8 * a.up_board.unitOrthogonal() + 1.0 * a.up_board;
+  Mast b = a;
+  b.axis_point_board += 0.5 * a.up_board;  // the same axis and ends, described from elsewhere
+  b.low_m -= 0.5, b.high_m -= 0.5;
+  EXPECT_TRUE(same_mast(a, b, antenna, 0.01));
+  Mast shifted = a;
+  shifted.axis_point_board += 0.015 * a.up_board.unitOrthogonal();
+  EXPECT_FALSE(same_mast(a, shifted, antenna, 0.01));
+  EXPECT_TRUE(same_mast(a, shifted, antenna, 0.02));
+  Mast tilted = a;  // through the same point at the antenna's height, 2° off
+  const Vec3 at_antenna = a.axis_point_board + a.up_board.dot(antenna - a.axis_point_board) * a.up_board;
+  tilted.up_board = (a.up_board + std::tan(deg2rad(2.0)) * a.up_board.unitOrthogonal()).normalized();
+  tilted.axis_point_board = at_antenna;
+  tilted.low_m = a.low_m - 1.0, tilted.high_m = a.high_m - 1.0;
+  EXPECT_FALSE(same_mast(a, tilted, antenna, 0.01));
+  Mast wider = a;
+  wider.radius_m += 0.015;
+  EXPECT_FALSE(same_mast(a, wider, antenna, 0.01));
+  Mast taller = a;
+  taller.high_m += 0.3;
+  EXPECT_FALSE(same_mast(a, taller, antenna, 0.01));
 }
 
 }  // namespace

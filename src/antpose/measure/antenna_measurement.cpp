@@ -257,6 +257,7 @@ OptionProblems AntennaOptions::Check() const {
   p.require(mast_clearance_m >= 0 && mast_outline_below_m > 0, "mast_clearance_m, mast_outline_below_m",
             "clearance ≥ 0, stretch > 0");
   p.require(mast_points_share > 0 && mast_points_share <= 1, "mast_points_share", "in (0, 1]");
+  p.require(same_mast_m >= 0, "same_mast_m", "≥ 0");
   p.require(reach_m > 0, "reach_m", "positive");
   p.require(warn_sigma_azimuth_deg > 0 && warn_sigma_downtilt_deg > 0,
             "warn_sigma_azimuth_deg, warn_sigma_downtilt_deg", "positive");
@@ -352,8 +353,13 @@ void measure_antenna(AntennaMeasurement& m, const model::AntennaModel* model, co
     proposals.insert(proposals.end(), previous.begin(), previous.end());
     auto r = registration::register_antenna(
         *model, scene, previous.empty() ? o.registration : registration::continuing(o.registration), proposals);
+    const auto known = [&](const reconstruction::Mast& mast) {
+      return objects.mast &&
+             reconstruction::same_mast(*objects.mast, mast, r.T_board_antenna.translation(), o.same_mast_m);
+    };
     if (r.found && o.mast)
-      if (auto mast = find_any_mast(m.region.cloud_board, r.T_board_antenna, model->size_m, c, objects, o)) {
+      if (auto mast = find_any_mast(m.region.cloud_board, r.T_board_antenna, model->size_m, c, objects, o);
+          mast && !known(*mast)) {
         objects.mast = m.mast = std::move(mast);
         auto with_mast = register_with_mast(*model, scene.points_board.size(), r.candidates, m, c, objects, o);
         if (with_mast.found) r = std::move(with_mast);

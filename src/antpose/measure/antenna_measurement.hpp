@@ -50,7 +50,10 @@ struct AntennaOptions {
   /// made known to a second registration, over this stretch below the panel. Where the mast holds
   /// at least `mast_points_share` of the region's points, the first registration's starts from the
   /// points were drawn towards it: the second one also starts afresh from the points without them.
+  /// A mast found again within `same_mast_m` of the one the registration already knew
+  /// (reconstruction::same_mast) needs no second registration: that one saw it.
   bool mast = true;
+  double same_mast_m = 0.01;
   double mast_clearance_m = 0.03;
   double mast_outline_below_m = 1.5;
   double mast_points_share = 0.1;

@@ -479,6 +479,18 @@ double distance_from_axis(const Mast& mast, const Vec3& p_board) {
   return (h.of(p_board) - h.of(mast.axis_point_board)).norm();
 }
 
+bool same_mast(const Mast& a, const Mast& b, const Vec3& p_board, double tolerance_m) {
+  const auto on_axis = [&](const Mast& m, double above_m) {
+    return Vec3(m.axis_point_board + (m.up_board.dot(p_board - m.axis_point_board) + above_m) * m.up_board);
+  };
+  const auto end = [](const Mast& m, double along_m) { return m.up_board.dot(m.axis_point_board) + along_m; };
+  return (on_axis(a, 0.0) - on_axis(b, 0.0)).norm() <= tolerance_m &&
+         (on_axis(a, 1.0) - on_axis(b, 1.0)).norm() <= tolerance_m &&
+         std::abs(a.radius_m - b.radius_m) <= tolerance_m &&
+         std::abs(end(a, a.low_m) - end(b, b.low_m)) <= tolerance_m &&
+         std::abs(end(a, a.high_m) - end(b, b.high_m)) <= tolerance_m;
+}
+
 double distance_from_surface(const Mast& mast, const Vec3& p_board) {
   return std::abs(distance_from_axis(mast, p_board) - mast.radius_m);
 }

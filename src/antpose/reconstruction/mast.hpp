@@ -100,6 +100,10 @@ std::array<std::vector<cv::Point2f>, 2> mast_outline(const Mast& mast, const cam
 /// The distance of `p_board` from the mast's axis, across it (m).
 double distance_from_axis(const Mast& mast, const Vec3& p_board);
 
+/// Whether `b` is the mast `a` found again: their axes within `tolerance_m` of each other at
+/// `p_board`'s height and over a metre along them, their radii and both ends within `tolerance_m`.
+bool same_mast(const Mast& a, const Mast& b, const Vec3& p_board, double tolerance_m);
+
 /// The horizontal distance of `p_board` from the mast's surface (m, ≥ 0; inside it too).
 double distance_from_surface(const Mast& mast, const Vec3& p_board);
 
