@@ -570,6 +570,38 @@ TEST(Silhouette, RejectsBadInput) {
   auto views = s.views;
   views[0].image = cv::Mat::zeros(10, 10, CV_8UC1);
   EXPECT_THROW(refine_by_silhouette(s.mesh_antenna, s.T_board_antenna, views, s.intrinsics, {}), std::invalid_argument);
+  for (const auto& bad : {SilhouetteOptions{.shape_tolerance_m = -0.001}, SilhouetteOptions{.shape_prior_edges = -1}})
+    EXPECT_THROW(refine_by_silhouette(s.mesh_antenna, s.T_board_antenna, s.views, s.intrinsics, bad),
+                 std::invalid_argument);
+}
+
+// The model's shape error is measured by the outline: a model of the panel photographed gives a
+// σ below the prior, one a centimetre too wide and deep gives one above it, and the prior's weight
+// moves the result between the two sources.
+TEST(Silhouette, TheModelsShapeErrorIsMeasuredByItsOffsetsFromTheOutline) {
+  const auto& s = scene();
+  SilhouetteOptions options;
+  options.rival_yaw_offsets_rad.clear();
+  const auto shape_sigma_m = [&](const model::Mesh& mesh, const SilhouetteOptions& o) {
+    const auto r = refine_by_silhouette(mesh, s.T_board_antenna, s.views, s.intrinsics, o);
+    std::printf("shape σ %.2f mm from %zu edges (prior %.1f mm × %.0f edges)\n", 1e3 * r.shape_sigma_m, r.shape_edges,
+                1e3 * o.shape_tolerance_m, o.shape_prior_edges);
+    EXPECT_GT(r.shape_edges, 6u);
+    return r.shape_sigma_m;
+  };
+  model::PanelSpec larger;
+  larger.width_m += 0.012, larger.depth_m += 0.008;
+  const auto too_large = model::parametric_panel(larger).mesh_antenna;
+
+  const double matching = shape_sigma_m(s.mesh_antenna, options);
+  const double departing = shape_sigma_m(too_large, options);
+  EXPECT_LT(matching, 0.75 * options.shape_tolerance_m);
+  EXPECT_GT(departing, options.shape_tolerance_m);
+  options.shape_prior_edges = 1e6;
+  EXPECT_NEAR(shape_sigma_m(too_large, options), options.shape_tolerance_m, 1e-5);
+  options.shape_prior_edges = 0;
+  EXPECT_LT(shape_sigma_m(s.mesh_antenna, options), matching);
+  EXPECT_GT(shape_sigma_m(too_large, options), departing);
 }
 
 // Development check on a simulated capture (`antpose simulate capture --scenario antenna`), with

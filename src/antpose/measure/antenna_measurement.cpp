@@ -143,6 +143,7 @@ void apply_registration(AntennaMeasurement& m, const model::AntennaModel& model,
   m.front_back = r.selection.front_back;
   m.front_back_cue = r.selection.front_back_cue;
   m.silhouette_rms_px = r.outline_rms_px;
+  m.model_shape_sigma_m = r.outline_shape_sigma_m;
   m.candidates = r.proposed;
   m.registration_candidates = r.candidates;
   m.method = fmt::format("model {}, outline in {} photos + points", model.name, r.outline_views);

@@ -92,6 +92,7 @@ struct AntennaMeasurement {
   double fit_rmse_m = 0.0;
   double fitness = 0.0;                                // share of region points within reach of the model
   std::optional<double> silhouette_rms_px;             // the outline's edge RMS
+  std::optional<double> model_shape_sigma_m;           // the model's shape error per edge, as the outline measured it
   std::optional<double> edge_radius_m;                 // the radome's edge rounding fitted (a parametric panel)
   std::optional<double> end_cap_rim_m;                 // how far its end caps stand out of the radome (fitted)
   std::vector<std::array<double, 2>> shapes_within_m;  // (radius, rim) the photos do not rule out

@@ -122,6 +122,7 @@ nlohmann::json antenna_json(const AntennaMeasurement& m) {
                  {"photos", m.mast->views},
                  {"edge_rms_px", m.mast->edge_rms_px}};
   a["outline_rms_px"] = m.silhouette_rms_px ? nlohmann::json(*m.silhouette_rms_px) : nullptr;
+  a["model_shape_sigma_m"] = m.model_shape_sigma_m ? nlohmann::json(*m.model_shape_sigma_m) : nullptr;
   a["photos_used"] = m.region.views_used;
   a["points"] = m.region.cloud_board.size();
   a["reconstruction"] = m.region.method;

@@ -402,6 +402,7 @@ AntennaRegistration select(const AntennaScene& s, std::vector<Refined> kept, con
   out.rotation_covariance_sources = rotation_sources(best);
   out.dilation_yaw_sigma_rad = best.outline.dilation_yaw_sigma_rad;
   out.outline_score = best.outline.score, out.outline_rms_px = best.outline.rms_px;
+  out.outline_shape_sigma_m = best.outline.shape_sigma_m;
   out.outline_views = best.outline.views_used;
   out.panel_shape = std::move(best.panel_shape);
   const auto facing_as_result = [&](std::size_t i) {

@@ -125,6 +125,7 @@ struct AntennaRegistration {
   std::optional<ShapeFit> panel_shape;  // where the model's shape was refitted
   double dilation_yaw_sigma_rad = 0.0;  // SilhouetteResult's
   double outline_score = 1.0, outline_rms_px = 0.0;
+  double outline_shape_sigma_m = 0.0;  // SilhouetteResult::shape_sigma_m: the model against the panel
   std::size_t outline_views = 0;
   RegistrationVerdict verdict = RegistrationVerdict::kUnique;
   std::vector<Iso3> rivals;       // other poses the evidence does not rule out (front and back as decided)

@@ -231,9 +231,52 @@ class Descender {
   bool reached_middle_ = false;  // by any search line of any evaluation
 };
 
+// σ_shape (file comment): each mesh edge's offset from the outline in metres and its noise
+// variance, the offsets' excess over their noise over G − 6 degrees of freedom, pooled with the
+// prior. The noise is the samples' scatter about their edge's offset, inflated for their overlap
+// as far as the edge has samples to overlap.
+struct ShapeSigma {
+  double sigma_m = 0;
+  std::size_t edges = 0;
+};
+
+ShapeSigma shape_sigma(const Gathered& g, const Normal& n, std::size_t edge_count, const SilhouetteOptions& o) {
+  struct Sums {
+    double wpr = 0, wpp = 0, w2pp = 0, w = 0, wrr = 0;
+    std::size_t count = 0;
+  };
+  std::vector<Sums> edge(edge_count);
+  for (const auto& view : g.per_view)
+    for (const auto& s : view) {
+      const double w = n.weight(s.r);
+      if (w <= 0 || s.px_per_m <= 0) continue;
+      auto& e = edge[s.edge];
+      e.wpr += w * s.px_per_m * s.r, e.wpp += w * s.px_per_m * s.px_per_m;
+      e.w2pp += w * w * s.px_per_m * s.px_per_m, e.w += w, e.wrr += w * s.r * s.r, ++e.count;
+    }
+  const double kappa = std::max(1.0, o.correlation_length_px / o.sample_spacing_px);
+  double scatter = 0, dof = 0;  // the samples' weighted scatter about their edge's offset
+  for (const auto& e : edge)
+    if (e.count > 1) scatter += e.wrr - e.wpr * e.wpr / e.wpp, dof += e.w - 1;
+  const double sigma2_px = dof > 0 ? std::max(0.0, scatter) / dof : 0.0;
+  double excess = 0;
+  std::size_t edges = 0;
+  for (const auto& e : edge) {
+    if (e.count < 2) continue;
+    const double offset = e.wpr / e.wpp;
+    const double noise = sigma2_px * std::min(kappa, double(e.count)) * e.w2pp / (e.wpp * e.wpp);
+    excess += offset * offset - noise, ++edges;
+  }
+  const double nu0 = o.shape_prior_edges, prior2 = o.shape_tolerance_m * o.shape_tolerance_m;
+  const double nu = edges > 6 ? double(edges - 6) : 0.0;
+  const double measured2 = nu > 0 ? std::max(0.0, excess) / nu : 0.0;
+  if (nu0 + nu <= 0) return {o.shape_tolerance_m, edges};
+  return {std::sqrt((nu0 * prior2 + nu * measured2) / (nu0 + nu)), edges};
+}
+
 // The covariance at the solution (file comment): the sandwich H⁻¹ (Σ_white + Σ_bias) H⁻¹ of white
 // edge noise (inflated for the samples' overlap), errors shared by all samples of a mesh edge (the
-// model's shape tolerance, the same in every view; an edge-localisation bias per view and edge:
+// model's shape error σ_shape, the same in every view; an edge-localisation bias per view and edge:
 // background, blur, shading) and that bias common to the whole outline (a dilation). The prior
 // counts once as information (in H) and once as its own noise (in M).
 void covariance_at(SilhouetteResult& result, const Gathered& g, const Normal& n, const Mat6& Hinv, double prior_weight,
@@ -246,13 +289,16 @@ void covariance_at(SilhouetteResult& result, const Gathered& g, const Normal& n,
   if (prior)
     noise.topLeftCorner<3, 3>() +=
         (prior_weight * prior_weight - sigma2 * inflation * prior_weight) * prior->information;
+  const ShapeSigma shape_error = shape_sigma(g, n, m.edges.size(), o);
+  result.shape_sigma_m = shape_error.sigma_m;
+  result.shape_edges = shape_error.edges;
   std::vector<Vec6> shape(m.edges.size(), Vec6::Zero()), bias(m.edges.size(), Vec6::Zero());
   Vec6 dilation = Vec6::Zero();
   for (const auto& view : g.per_view)
     for (const auto& s : view) {
       const double w = n.weight(s.r);
       if (w <= 0) continue;
-      shape[s.edge] += w * s.px_per_m * o.shape_tolerance_m * s.J.transpose();
+      shape[s.edge] += w * s.px_per_m * shape_error.sigma_m * s.J.transpose();
       bias[s.edge] += w * o.edge_bias_px * s.J.transpose();
       dilation += w * o.outline_dilation_px * s.J.transpose();
     }
@@ -382,11 +428,16 @@ std::vector<SilhouetteResult> refine_by_silhouette_runs(const model::Mesh& mesh_
                                                         const std::optional<RotationPrior>& prior) {
   if (mesh_antenna.triangles.empty()) throw std::invalid_argument("refine_by_silhouette: the mesh has no triangles");
   if (runs.empty()) return {};
-  for (const auto& run : runs)
+  for (const auto& run : runs) {
+    if (!(run.shape_tolerance_m >= 0 && run.shape_prior_edges >= 0))
+      throw std::invalid_argument(
+          fmt::format("refine_by_silhouette: shape_tolerance_m {} and shape_prior_edges {} must not be negative",
+                      run.shape_tolerance_m, run.shape_prior_edges));
     if (!prepared_alike(run, runs.front()))
       throw std::invalid_argument(
           "refine_by_silhouette_runs: the runs must prepare the photos alike (roi_margin_px, gamma, "
           "smoothing_sigma_px, mask_guard_px, min_coarse_width_px)");
+  }
   const EdgeMesh m = weld(mesh_antenna);
   const Pose start{T_board_antenna_initial.linear(), T_board_antenna_initial.translation()};
   int max_level = 0;

@@ -39,9 +39,9 @@
 // residual variance, κ = correlation_length_px / sample_spacing_px because neighbouring samples
 // share the blur and JPEG blocks. The sum models errors common to all samples of a mesh edge,
 // which do not average out along it nor over the views: b_g = Σ_{i∈g} w_i J_iᵀ s_i over all views,
-// once with s_i = f · shape_tolerance_m / depth (the model's shape error: a real radome's
-// extrusion, rounding and end caps depart from the model by millimetres along a whole edge, and
-// where the views leave a turn weakly observed, such as a panel seen from below turning about the
+// once with s_i = f · σ_shape / depth (the model's shape error: a real radome's extrusion,
+// rounding and end caps depart from the model by millimetres along a whole edge, and where the
+// views leave a turn weakly observed, such as a panel seen from below turning about the
 // horizontal across the line of sight, that error reads as tenths of a degree) and once with
 // s_i = edge_bias_px (edge localisation biased by the shading of rounded edges near the outline and
 // by the background, both similar from view to view under one sun). One more such b, over every
@@ -49,6 +49,14 @@
 // narrower) than the model's by the same amount everywhere: blur and the shading of the rounded
 // long edges do that in every photo alike, and for a narrow panel seen face-on only the yaw can
 // widen the outline, so a dilation of a fraction of a pixel reads as degrees of yaw.
+// σ_shape is measured where the photos show it: each mesh edge's offset from its outline,
+// d_g = Σ w p r / Σ w p² (m; p = f / depth), has the noise variance v_g of its samples' scatter
+// about it, so over the G edges that show one the shape error's variance is estimated as
+// σ̂² = Σ (d_g² − v_g) / (G − 6), six of the offsets being taken up by the pose. It is pooled with
+// the prior shape_tolerance_m, which counts as shape_prior_edges edges (a scaled inverse-χ²
+// prior; Gelman et al., Bayesian Data Analysis, 3rd ed., §2.6):
+//   σ_shape² = (ν₀ σ₀² + (G − 6) σ̂²) / (ν₀ + G − 6),
+// so a model that departs from the panel widens the σ it gives, and one that matches narrows it.
 #pragma once
 
 #include <array>
@@ -112,7 +120,8 @@ struct SilhouetteOptions {
   double roi_margin_px = 40;          // around the projected model (plus 10 % of its size)
   double mask_guard_px = 3;           // occluders and background edges widened by this, per level
   double correlation_length_px = 12;  // covariance inflation (see the file comment)
-  double shape_tolerance_m = 0.002;   // model vs real panel, per mesh edge (covariance)
+  double shape_tolerance_m = 0.002;   // model vs real panel, per mesh edge: the prior σ₀ (covariance)
+  double shape_prior_edges = 4;       // ν₀: σ₀'s weight, in mesh edges, against the offsets measured
   double edge_bias_px = 0.1;          // edge-localisation bias per mesh edge, all views (covariance)
   double outline_dilation_px = 0.10;  // the same, common to the whole outline in all views (covariance)
   // The model's box (width, depth, height along x_a, y_a, z_a, centred at the antenna frame's
@@ -164,6 +173,10 @@ struct SilhouetteResult {
   /// SilhouetteOptions::outline_dilation_px alone (rad): large where the outline's width barely
   /// changes with yaw (a narrow panel seen face-on), which wider-spread views cure.
   double dilation_yaw_sigma_rad = 0;
+  /// The model's shape error per mesh edge that covariance holds (σ_shape, m; file comment), and
+  /// the mesh edges whose offsets from the outline measured it.
+  double shape_sigma_m = 0;
+  std::size_t shape_edges = 0;
   double rms_px = 0;  // weighted edge-distance RMS of the samples used, full resolution
   double inlier_fraction = 0;
   double score = 1;  // mean truncated cost of the outline, 0 (perfect) .. 1 (no edge found)
