@@ -235,25 +235,20 @@ class Descender {
 // variance, the offsets' excess over their noise over G − 6 degrees of freedom, pooled with the
 // prior. The noise is the samples' scatter about their edge's offset, inflated for their overlap
 // as far as the edge has samples to overlap.
+struct EdgeOffset {  // weighted sums over one mesh edge's samples (w weight, p px per m, r residual)
+  double wpr = 0, wpp = 0, w2pp = 0, w = 0, wrr = 0;
+  std::size_t count = 0;
+  void add(double wi, double p, double r) {
+    wpr += wi * p * r, wpp += wi * p * p, w2pp += wi * wi * p * p, w += wi, wrr += wi * r * r, ++count;
+  }
+};
+
 struct ShapeSigma {
   double sigma_m = 0;
   std::size_t edges = 0;
 };
 
-ShapeSigma shape_sigma(const Gathered& g, const Normal& n, std::size_t edge_count, const SilhouetteOptions& o) {
-  struct Sums {
-    double wpr = 0, wpp = 0, w2pp = 0, w = 0, wrr = 0;
-    std::size_t count = 0;
-  };
-  std::vector<Sums> edge(edge_count);
-  for (const auto& view : g.per_view)
-    for (const auto& s : view) {
-      const double w = n.weight(s.r);
-      if (w <= 0 || s.px_per_m <= 0) continue;
-      auto& e = edge[s.edge];
-      e.wpr += w * s.px_per_m * s.r, e.wpp += w * s.px_per_m * s.px_per_m;
-      e.w2pp += w * w * s.px_per_m * s.px_per_m, e.w += w, e.wrr += w * s.r * s.r, ++e.count;
-    }
+ShapeSigma shape_sigma(const std::vector<EdgeOffset>& edge, const SilhouetteOptions& o) {
   const double kappa = std::max(1.0, o.correlation_length_px / o.sample_spacing_px);
   double scatter = 0, dof = 0;  // the samples' weighted scatter about their edge's offset
   for (const auto& e : edge)
@@ -289,22 +284,27 @@ void covariance_at(SilhouetteResult& result, const Gathered& g, const Normal& n,
   if (prior)
     noise.topLeftCorner<3, 3>() +=
         (prior_weight * prior_weight - sigma2 * inflation * prior_weight) * prior->information;
-  const ShapeSigma shape_error = shape_sigma(g, n, m.edges.size(), o);
-  result.shape_sigma_m = shape_error.sigma_m;
-  result.shape_edges = shape_error.edges;
+  // Per mesh edge: b_g for a shape error of 1 m (scaled by σ_shape once it is measured from the
+  // same samples' offsets) and for the edge bias.
   std::vector<Vec6> shape(m.edges.size(), Vec6::Zero()), bias(m.edges.size(), Vec6::Zero());
+  std::vector<EdgeOffset> offsets(m.edges.size());
   Vec6 dilation = Vec6::Zero();
   for (const auto& view : g.per_view)
     for (const auto& s : view) {
       const double w = n.weight(s.r);
       if (w <= 0) continue;
-      shape[s.edge] += w * s.px_per_m * shape_error.sigma_m * s.J.transpose();
+      if (s.px_per_m > 0) offsets[s.edge].add(w, s.px_per_m, s.r);
+      shape[s.edge] += w * s.px_per_m * s.J.transpose();
       bias[s.edge] += w * o.edge_bias_px * s.J.transpose();
       dilation += w * o.outline_dilation_px * s.J.transpose();
     }
+  const ShapeSigma shape_error = shape_sigma(offsets, o);
+  result.shape_sigma_m = shape_error.sigma_m;
+  result.shape_edges = shape_error.edges;
   Mat6 shape_M = Mat6::Zero(), bias_M = Mat6::Zero();
   for (std::size_t e = 0; e < m.edges.size(); ++e)
     shape_M += shape[e] * shape[e].transpose(), bias_M += bias[e] * bias[e].transpose();
+  shape_M *= shape_error.sigma_m * shape_error.sigma_m;
   auto& parts = result.covariance_parts;
   parts.noise = Hinv * noise * Hinv;
   parts.shape = Hinv * shape_M * Hinv;
