@@ -575,6 +575,22 @@ TEST(Silhouette, RejectsBadInput) {
                  std::invalid_argument);
 }
 
+// The options say what is wrong with them, naming the field.
+TEST(Silhouette, OptionsAreChecked) {
+  EXPECT_TRUE(SilhouetteOptions{}.Check().ok());
+  const auto names = [](const SilhouetteOptions& o, const std::string& field) {
+    return o.Check().message().find(field) != std::string::npos;
+  };
+  EXPECT_TRUE(names({.free = {false, false, false, false, false, false}}, "free"));
+  EXPECT_TRUE(names({.min_inlier_fraction = 1.5}, "min_inlier_fraction"));
+  EXPECT_TRUE(names({.sample_spacing_px = 0}, "sample_spacing_px"));
+  EXPECT_TRUE(names({.rival_yaw_offsets_rad = {4.0}}, "rival_yaw_offsets_rad"));
+  EXPECT_TRUE(names({.max_iterations_per_level = -1}, "max_iterations_per_level"));
+  const auto& s = scene();
+  EXPECT_THROW(evaluate_outline(s.mesh_antenna, s.T_board_antenna, s.views, s.intrinsics, {.min_views = 0}),
+               std::invalid_argument);
+}
+
 // The model's shape error is measured by the outline: a model of the panel photographed gives a
 // σ below the prior, one a centimetre too wide and deep gives one above it, and the prior's weight
 // moves the result between the two sources.

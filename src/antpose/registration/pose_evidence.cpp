@@ -81,6 +81,7 @@ double seen_face_noise(const std::vector<Vec3>& points_antenna, const Vec3& size
 
 OptionProblems EvidenceOptions::Check() const {
   OptionProblems p;
+  p.nest("outline", outline.Check());
   p.require(point_slices >= 1, "point_slices", "at least 1");
   p.require(point_truncation_m > 0, "point_truncation_m", "positive");
   p.require(points_weight >= 0 && side_mount_weight >= 0 && side_mount_outline_weight >= 0,

@@ -445,6 +445,7 @@ OptionProblems RegisterOptions::Check() const {
   p.nest("search", search.Check());
   p.nest("turns", turns.Check());
   p.nest("slide", slide.Check());
+  p.nest("refine", refine.Check());
   p.nest("evidence", evidence.Check());
   p.nest("selection", selection.Check());
   p.nest("panel_shape", panel_shape.Check());

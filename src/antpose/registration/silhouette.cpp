@@ -420,6 +420,38 @@ bool prepared_alike(const SilhouetteOptions& a, const SilhouetteOptions& b) {
 
 }  // namespace
 
+OptionProblems SilhouetteOptions::Check() const {
+  OptionProblems p;
+  p.require(search_range_px > 0 && fine_search_px > 0, "search_range_px, fine_search_px", "positive");
+  p.require(sample_spacing_px > 0, "sample_spacing_px", "positive");
+  p.require(min_edge_gradient >= 0 && smoothing_sigma_px >= 0 && gamma >= 0,
+            "min_edge_gradient, smoothing_sigma_px, gamma", "≥ 0");
+  p.require(max_level >= 0 && max_level <= 12, "max_level", "in [0, 12]");
+  p.require(min_coarse_width_px > 0, "min_coarse_width_px", "positive");
+  p.require(max_iterations_per_level >= 0 && max_step_halvings >= -1, "max_iterations_per_level, max_step_halvings",
+            "≥ 0 and ≥ −1");
+  p.require(swing_motion_px >= 0, "swing_motion_px", "≥ 0");
+  p.require(max_step_rotation_rad > 0 && max_rotation_change_rad > 0, "max_step_rotation_rad, max_rotation_change_rad",
+            "positive");
+  p.require(tukey_c > 0, "tukey_c", "positive");
+  p.require(roi_margin_px >= 0 && mask_guard_px >= 0 && correlation_length_px >= 0,
+            "roi_margin_px, mask_guard_px, correlation_length_px", "≥ 0");
+  p.require(shape_tolerance_m >= 0 && shape_prior_edges >= 0, "shape_tolerance_m, shape_prior_edges", "≥ 0");
+  p.require(edge_bias_px >= 0 && outline_dilation_px >= 0, "edge_bias_px, outline_dilation_px", "≥ 0");
+  p.require((outline_box_m.array() >= 0).all() && box_tolerance_m >= 0, "outline_box_m, box_tolerance_m", "each ≥ 0");
+  p.require(std::any_of(free.begin(), free.end(), [](bool f) { return f; }), "free", "at least one degree of freedom");
+  p.require(std::all_of(rival_yaw_offsets_rad.begin(), rival_yaw_offsets_rad.end(),
+                        [](double a) { return std::abs(a) <= M_PI; }),
+            "rival_yaw_offsets_rad", "each within ±π");
+  p.require(score_cutoff_px > 0 && rival_margin >= 0, "score_cutoff_px, rival_margin", "cutoff positive, margin ≥ 0");
+  p.require(
+      min_inlier_fraction >= 0 && min_inlier_fraction <= 1 && max_outside_fraction >= 0 && max_outside_fraction <= 1,
+      "min_inlier_fraction, max_outside_fraction", "in [0, 1]");
+  p.require(max_rms_px > 0, "max_rms_px", "positive");
+  p.require(min_views >= 1, "min_views", "at least 1");
+  return p;
+}
+
 std::vector<SilhouetteResult> refine_by_silhouette_runs(const model::Mesh& mesh_antenna,
                                                         const Iso3& T_board_antenna_initial,
                                                         const std::vector<SilhouetteView>& views,
@@ -429,10 +461,7 @@ std::vector<SilhouetteResult> refine_by_silhouette_runs(const model::Mesh& mesh_
   if (mesh_antenna.triangles.empty()) throw std::invalid_argument("refine_by_silhouette: the mesh has no triangles");
   if (runs.empty()) return {};
   for (const auto& run : runs) {
-    if (!(run.shape_tolerance_m >= 0 && run.shape_prior_edges >= 0))
-      throw std::invalid_argument(
-          fmt::format("refine_by_silhouette: shape_tolerance_m {} and shape_prior_edges {} must not be negative",
-                      run.shape_tolerance_m, run.shape_prior_edges));
+    throw_unless_ok(run.Check(), "SilhouetteOptions");
     if (!prepared_alike(run, runs.front()))
       throw std::invalid_argument(
           "refine_by_silhouette_runs: the runs must prepare the photos alike (roi_margin_px, gamma, "
@@ -464,6 +493,7 @@ std::vector<OutlineEvaluation> evaluate_outlines(const model::Mesh& mesh_antenna
                                                  const camera::CameraIntrinsics& intrinsics,
                                                  const SilhouetteOptions& options) {
   if (mesh_antenna.triangles.empty()) throw std::invalid_argument("evaluate_outline: the mesh has no triangles");
+  throw_unless_ok(options.Check(), "SilhouetteOptions");
   if (poses.empty()) return {};
   const EdgeMesh m = weld(mesh_antenna);
   std::vector<Pose> at;

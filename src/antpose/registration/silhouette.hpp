@@ -68,6 +68,7 @@
 #include <opencv2/core.hpp>
 
 #include "antpose/camera/camera_model.hpp"
+#include "antpose/core/check.hpp"
 #include "antpose/geometry/point_cloud.hpp"
 #include "antpose/model/mesh.hpp"
 #include "antpose/registration/edge_pyramid.hpp"
@@ -142,6 +143,7 @@ struct SilhouetteOptions {
   double max_rms_px = 2.5;                         // at full resolution
   double max_rotation_change_rad = deg2rad(15.0);  // 15° from the start: beyond, a different local minimum
   int min_views = 2;
+  OptionProblems Check() const;
 };
 
 /// A Gaussian prior on the rotation from another measurement (e.g. the long axis from the 3-D
