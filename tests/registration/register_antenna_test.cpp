@@ -145,7 +145,7 @@ TEST(RegisterAntenna, AStartInAMirrorYawsBasinIsTurnedToThePanel) {
   mirror.linear() = exp_so3(*far * mirror.linear().col(2)) * mirror.linear();
   const std::vector<PoseCandidate> start{{mirror, Strategy::kGiven, {}, 0.0, nullptr}};
   RegisterOptions without;
-  without.turns.of_best = 0;
+  without.turns.of_best = 0, without.crease_twins = false;
   const auto stuck = register_antenna(model, scene, without, start);
   ASSERT_TRUE(stuck.found) << stuck.why_not;
   EXPECT_GT(rad2deg(box_angle(stuck.T_board_antenna.linear(), s.T_board_antenna.linear())), 10.0)
@@ -155,6 +155,39 @@ TEST(RegisterAntenna, AStartInAMirrorYawsBasinIsTurnedToThePanel) {
   ASSERT_TRUE(r.found) << r.why_not;
   EXPECT_LT(rad2deg(rotation_distance(r.T_board_antenna.linear(), s.T_board_antenna.linear())), 1.0);
   EXPECT_EQ(r.candidates[r.selection.best].strategy, Strategy::kTurned);
+}
+
+// Held where a faint side face would leave it, turned by atan(d / w) with its diagonal along the
+// panel's front face (yaw_turns.hpp), the registration places that pose's crease twin on the panel;
+// the panel's own outline, all four long edges seen here, then wins. Without the twins it stays.
+TEST(RegisterAntenna, APoseLyingOnTheCreaseHasThePanelAsItsTwin) {
+  const SyntheticScene s = make_scene();
+  const AntennaScene scene = antenna_scene(s);
+  const auto model = model::parametric_panel({});
+  const Vec3 box = model::outline_box(model);
+  const Vec3 z = s.T_board_antenna.linear().col(2), y = s.T_board_antenna.linear().col(1);
+  // The fixture's photos face the front (+y_a): its middle is d/2 along y_a.
+  Iso3 on_crease = s.T_board_antenna;
+  on_crease.linear() = exp_so3(std::atan2(box.y(), box.x()) * z) * on_crease.linear();
+  on_crease.translation() += 0.5 * box.y() * y;
+  RegisterOptions o;
+  o.turns.of_best = 0, o.slide.of_best = 0, o.points_start = false;
+  const std::vector<PoseCandidate> start{{on_crease, Strategy::kPointsHeld, {}, 0.0, nullptr}};
+  const auto r = register_antenna(model, scene, o, start);
+  ASSERT_TRUE(r.found) << r.why_not;
+  const auto at_panel = [&](const PoseCandidate& c) {
+    return c.strategy == Strategy::kCreaseTwin &&
+           rad2deg(box_angle(c.T_board_antenna.linear(), s.T_board_antenna.linear())) < 0.5 &&
+           (c.T_board_antenna.translation() - s.T_board_antenna.translation()).norm() < 0.01;
+  };
+  EXPECT_EQ(std::count_if(r.candidates.begin(), r.candidates.end(), at_panel), 1);
+  EXPECT_LT(rad2deg(box_angle(r.T_board_antenna.linear(), s.T_board_antenna.linear())), 0.5);
+  EXPECT_GT(r.rotation_covariance_board().trace(), 0.0) << "the twin's rotation is measured, not held";
+
+  o.crease_twins = false;
+  const auto without = register_antenna(model, scene, o, start);
+  ASSERT_TRUE(without.found) << without.why_not;
+  EXPECT_GT(rad2deg(box_angle(without.T_board_antenna.linear(), s.T_board_antenna.linear())), 10.0);
 }
 
 // The points' starts are also candidates where the points place them: with the region's points

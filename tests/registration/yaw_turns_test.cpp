@@ -8,6 +8,7 @@
 
 #include "antpose/geometry/rotation.hpp"
 #include "antpose/model/box_file.hpp"
+#include "antpose/registration/pose_selection.hpp"
 
 namespace antpose::registration {
 namespace {
@@ -114,6 +115,34 @@ TEST(YawTurns, FacingTurnPutsAFaceTowardsTheDirection) {
     EXPECT_NEAR(std::abs(U->linear().col(1).dot(across)), 1.0, 1e-9) << direction.transpose();
   }
   EXPECT_FALSE(facing_turn(T, 2.0 * z));
+}
+
+// A box turned by θ* and centred on the middle of another's front face lays its diagonal along that
+// face, its ends beyond the face's corners by only (√(w² + d²) − w) / 2: the outline the front face
+// alone shows, where a side face is too faint to be seen. Its crease twin is the other box.
+TEST(YawTurns, TheCreaseTwinOfABoxLyingOnAFrontFaceIsThatFacesBox) {
+  const Iso3 T = box_facing(deg2rad(10.0));
+  const auto viewpoints = viewpoints_along_y(T, 20.0);  // towards T's front face (+y_a)
+  for (const double sign : {1.0, -1.0}) {
+    Iso3 W = turned(T, sign * deg2rad(kDiagonalDeg));
+    W.translation() = T * Vec3(0.0, 0.5 * kBox.y(), 0.0);
+    std::size_t on_face = 0;
+    for (const Vec3& c : model::box_corners(kBox)) {
+      const Vec3 in_T = T.inverse() * (W * c);
+      if (std::abs(in_T.y() - 0.5 * kBox.y()) > 1e-9) continue;
+      ++on_face;
+      EXPECT_NEAR(std::abs(in_T.x()), 0.5 * std::hypot(kBox.x(), kBox.y()), 1e-9);
+    }
+    EXPECT_EQ(on_face, 4u) << "a diagonal's two edges, top and bottom corners";
+    const auto twins = crease_twins(W, kBox, viewpoints);
+    ASSERT_EQ(twins.size(), 2u);
+    const auto is_T = [&](const Iso3& U) {
+      return box_angle(U.linear(), T.linear()) < 1e-9 && (U.translation() - T.translation()).norm() < 1e-9;
+    };
+    EXPECT_EQ(std::count_if(twins.begin(), twins.end(), is_T), 1) << sign;
+    for (const Iso3& U : twins)
+      EXPECT_NEAR(rad2deg(angle_between(U.linear().col(2), W.linear().col(2))), 0.0, 1e-9) << "about the long axis";
+  }
 }
 
 TEST(YawTurns, OptionsAreChecked) {

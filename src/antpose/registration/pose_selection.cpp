@@ -89,6 +89,8 @@ std::string to_string(Strategy strategy) {
       return "slid along its long axis";
     case Strategy::kFacingMast:
       return "turned to face the mast";
+    case Strategy::kCreaseTwin:
+      return "crease twin of the best";
     case Strategy::kGiven:
       break;
   }
@@ -182,7 +184,10 @@ Selection select_pose(const std::vector<PoseCandidate>& candidates, const std::v
       continue;
     }
     if (!s.runner_up) s.runner_up = versus;
-    if (!versus.decisive || !ranks_first_at_every_weight(candidates[s.best].evidence, c.evidence, evidence))
+    const bool crease_leans =
+        c.strategy == Strategy::kCreaseTwin && placement_leans_to(c.evidence, candidates[s.best].evidence, evidence);
+    if (!versus.decisive || crease_leans ||
+        !ranks_first_at_every_weight(candidates[s.best].evidence, c.evidence, evidence))
       s.rivals.push_back(order[k]);
   }
   if (mast)

@@ -15,7 +15,10 @@
 // mount's points taken for the panel's, is common to every unit of one half and escapes the
 // comparison's noise, so where the two halves point to different poses, the winner must stay first
 // at every weight. The noise test stays at the nominal weight: at the ends of the range one half's
-// scatter swamps the other's, and a margin that is real would read as noise there.
+// scatter swamps the other's, and a margin that is real would read as noise there. A crease twin of
+// the winner (yaw_turns.hpp: turned by atan(depth / width), where a faint side face lets a box lay
+// its outline on the crease) is that crease error at its full size, often beyond rival_min_deg: it
+// is a rival wherever its placement leans to it as a near candidate's would.
 // Then front and back, which the box's outline cannot tell: the winner against its twin turned
 // by 180° about its long axis. A known mast decides first where it stands clearly behind one of
 // them (a panel's back plate faces its mount); otherwise the side units (the vertical structure
@@ -57,6 +60,7 @@ enum class Strategy {
   kTurnedAndPlaced,  // a turned start placed again by the outline
   kSlid,             // axis_slide.hpp
   kFacingMast,       // yaw_turns.hpp's facing_turn: turned about its long axis to face a known mast
+  kCreaseTwin,       // yaw_turns.hpp's crease_twins of the best, placed by the outline at that turn
 };
 std::string to_string(Strategy strategy);  // as reports name it, e.g. "outline search"
 

@@ -113,8 +113,16 @@ std::vector<Refined> refine_all(const std::shared_ptr<const model::AntennaModel>
     std::vector<SilhouetteOptions> runs;
     if (!(hold_it && was_held)) runs = {descent, polish};
     if (hold_it) runs.push_back(hold);
-    auto outlines =
-        refine_by_silhouette_runs(with->mesh_antenna, proposal.T_board_antenna, s.views, s.intrinsics, runs);
+    // A crease twin stands for its turn (yaw_turns.hpp): its centre is placed at that turn first,
+    // then polished whole; a descent through the pyramid would leave it for the crease's basin.
+    Iso3 start = proposal.T_board_antenna;
+    if (proposal.strategy == Strategy::kCreaseTwin) {
+      auto place = polish;
+      place.free = {false, false, false, true, true, true};
+      start = refine_by_silhouette(with->mesh_antenna, start, s.views, s.intrinsics, place).T_board_antenna;
+      runs = {polish};
+    }
+    auto outlines = refine_by_silhouette_runs(with->mesh_antenna, start, s.views, s.intrinsics, runs);
     for (std::size_t k = 0; k < runs.size(); ++k) {
       Refined& r = out.emplace_back();
       r.outline = std::move(outlines[k]);
@@ -263,7 +271,8 @@ std::vector<Refined> refine_and_turn(const std::shared_ptr<const model::AntennaM
   return distinct_in_rectangle(std::move(kept), *shared, s, o);
 }
 
-// The best candidates' shape (edge rounding, end caps) profiled with their poses (shape_fit.hpp):
+// The best candidates' shape (edge rounding, end caps) profiled with their poses (shape_fit.hpp),
+// and every crease twin's (yaw_turns.hpp: it was placed with the shape that fits the best):
 // each then carries its best shape's pose, outline and model. Before any judgement of the outline:
 // fitted with the wrong shape, even the right pose may fit its outline poorly. A candidate whose
 // shape a previous registration profiled within same_pose of where it now stands keeps that
@@ -271,9 +280,11 @@ std::vector<Refined> refine_and_turn(const std::shared_ptr<const model::AntennaM
 // Candidates that profiling brings onto one pose are one: the kept profile, else the better outline.
 void fit_shapes(std::vector<Refined>& kept, const AntennaScene& s, const RegisterOptions& o) {
   const auto same = [&](const Iso3& T, const Iso3& U) { return same_place(T, U, o.same_pose_deg, o.same_pose_m); };
-  const std::size_t n = std::min(kept.size(), o.shape_candidates);
-  std::vector<bool> carried(n, false);
-  for (std::size_t i = 0; i < n; ++i) {
+  std::vector<std::size_t> profiled;
+  for (std::size_t i = 0; i < kept.size(); ++i)
+    if (i < o.shape_candidates || kept[i].candidate.strategy == Strategy::kCreaseTwin) profiled.push_back(i);
+  std::vector<bool> carried(kept.size(), false);
+  for (const std::size_t i : profiled) {
     auto& k = kept[i];
     if (k.held()) continue;
     if (k.panel_shape && same(k.candidate.T_board_antenna, k.panel_shape->outline.T_board_antenna)) {
@@ -293,8 +304,9 @@ void fit_shapes(std::vector<Refined>& kept, const AntennaScene& s, const Registe
     k.panel_shape = std::move(fit);
   }
   std::vector<bool> merged(kept.size(), false);
-  for (std::size_t i = 0; i < n; ++i)
-    for (std::size_t j = i + 1; j < n; ++j) {
+  for (std::size_t a = 0; a < profiled.size(); ++a)
+    for (std::size_t b = a + 1; b < profiled.size(); ++b) {
+      const std::size_t i = profiled[a], j = profiled[b];
       if (merged[i] || merged[j] || !same(kept[i].candidate.T_board_antenna, kept[j].candidate.T_board_antenna))
         continue;
       const bool keep_j = carried[j] != carried[i] ? carried[j] : kept[j].outline.score < kept[i].outline.score;
@@ -304,6 +316,27 @@ void fit_shapes(std::vector<Refined>& kept, const AntennaScene& s, const Registe
   for (std::size_t i = 0; i < kept.size(); ++i)
     if (!merged[i]) distinct.push_back(std::move(kept[i]));
   kept = std::move(distinct);
+}
+
+// The best candidate's crease twins (yaw_turns.hpp) with its model, placed by the outline at their
+// own turn (refine_all), where they fit the rectangle and no candidate stands yet; their own shape
+// is profiled next (fit_shapes).
+void add_crease_twins(std::vector<Refined>& kept, const AntennaScene& s, const RegisterOptions& o) {
+  if (!o.crease_twins || kept.empty()) return;
+  const auto best = std::min_element(
+      kept.begin(), kept.end(), [](const Refined& a, const Refined& b) { return a.outline.score < b.outline.score; });
+  const auto with = best->model;
+  std::vector<PoseCandidate> twins;
+  for (const Iso3& T : crease_twins(best->candidate.T_board_antenna, model::outline_box(*with), s.viewpoints_board))
+    twins.push_back({T, Strategy::kCreaseTwin, {}, 0.0, nullptr});
+  auto placed = refine_all(with, s, twins, o);
+  std::erase_if(placed, [&](const Refined& m) {
+    return std::any_of(kept.begin(), kept.end(), [&](const Refined& k) {
+      return same_place(m.candidate.T_board_antenna, k.candidate.T_board_antenna, o.same_pose_deg, o.same_pose_m);
+    });
+  });
+  kept.insert(kept.end(), std::make_move_iterator(placed.begin()), std::make_move_iterator(placed.end()));
+  kept = distinct_in_rectangle(std::move(kept), *with, s, o);
 }
 
 // The candidates whose outline meets the photos' edges at least faintly (max_faint_outline_score,
@@ -505,6 +538,7 @@ AntennaRegistration register_antenna(const model::AntennaModel& model, const Ant
   check_scene(s);
   const auto shared = std::make_shared<const model::AntennaModel>(model);
   auto kept = refine_and_turn(shared, s, proposals, o);
+  add_crease_twins(kept, s, o);
   fit_shapes(kept, s, o);
   keep_fitting_outlines(kept, s, o);
   if (kept.empty()) {

@@ -7,8 +7,10 @@
 //                                                  turned to face a known mast it turns a side
 //                                                  to; the best ones slid along it
 //                                                  (axis_slide.hpp); each
-//                                                  refined too; the best ones' shape (edges, end
-//                                                  caps) profiled with their pose (shape_fit.hpp);
+//                                                  refined too; the best's crease twins placed
+//                                                  (yaw_turns.hpp); the best ones' and the twins'
+//                                                  shape (edges, end caps) profiled with their
+//                                                  pose (shape_fit.hpp);
 //                                                  the points' starts also kept as they lie
 //                                                         │
 //                                    evidence of each and of each turned round (pose_evidence.hpp)
@@ -72,6 +74,7 @@ struct RegisterOptions {
   bool place_turns = true;            // each turned start also placed by the outline at its own orientation
   bool face_mast = true;              // the best turned to face a known mast it turns a side to (facing_turn)
   AxisSlideOptions slide;             // the best refined candidates slid along their long axis (axis_slide.hpp)
+  bool crease_twins = true;           // the best's crease twins (yaw_turns.hpp), placed by the outline at their turn
   /// The points' starts also kept where the points place them, their outline not descended:
   /// where a faint stretch of the true outline lets the descent lay it on a crease, the descent
   /// leaves the pose the points hold, and the selection could never weigh it.

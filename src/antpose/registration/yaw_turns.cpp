@@ -15,6 +15,21 @@ OptionProblems YawTurnOptions::Check() const {
   return p;
 }
 
+namespace {
+
+std::vector<Iso3> turned_about_long_axis(const Iso3& T_board_antenna, const std::vector<double>& turns) {
+  std::vector<Iso3> out;
+  const Vec3 z = T_board_antenna.linear().col(2);
+  for (const double turn : turns) {
+    Iso3 T = T_board_antenna;
+    T.linear() = exp_so3(turn * z) * T_board_antenna.linear();
+    out.push_back(T);
+  }
+  return out;
+}
+
+}  // namespace
+
 double view_angle(const Iso3& T_board_antenna, const std::vector<Vec3>& viewpoints_board) {
   const Mat3 R = T_board_antenna.linear();
   const Vec3 z = R.col(2);
@@ -60,12 +75,22 @@ std::vector<Iso3> yaw_turns(const Iso3& T_board_antenna, const Vec3& outline_box
   for (const double t : candidates)
     if (apart(t, 0.0) && std::all_of(turns.begin(), turns.end(), [&](double u) { return apart(t, u); }))
       turns.push_back(t);
-  std::vector<Iso3> out;
-  const Vec3 z = T_board_antenna.linear().col(2);
-  for (const double turn : turns) {
-    Iso3 T = T_board_antenna;
-    T.linear() = exp_so3(turn * z) * T_board_antenna.linear();
-    out.push_back(T);
+  return turned_about_long_axis(T_board_antenna, turns);
+}
+
+std::vector<double> crease_turns(const Vec3& outline_box_m) {
+  const double theta = std::atan2(outline_box_m.y(), outline_box_m.x());
+  return {theta, -theta};
+}
+
+std::vector<Iso3> crease_twins(const Iso3& T_board_antenna, const Vec3& outline_box_m,
+                               const std::vector<Vec3>& viewpoints_board) {
+  auto out = turned_about_long_axis(T_board_antenna, crease_turns(outline_box_m));
+  for (Iso3& T : out) {
+    // The boresight's side towards the photos: cos(φ) > 0 at the twin's own view angle.
+    const Vec3 y = T.linear().col(1);
+    const double towards = std::cos(view_angle(T, viewpoints_board)) >= 0 ? 1.0 : -1.0;
+    T.translation() -= towards * 0.5 * outline_box_m.y() * y;
   }
   return out;
 }

@@ -12,7 +12,15 @@
 //  - A grid of turns (turns_deg) about the candidate's own long axis, spaced about a basin's width,
 //    for the basins no symmetry predicts (a face's inner edges, brackets and end caps lining up
 //    with the photo's edges at another yaw).
-// φ is taken for the mean direction to the photos. A third start comes from outside the photos: a
+// φ is taken for the mean direction to the photos. A third kind reaches the true pose where the
+// descent cannot: crease twins. Where a side face is too faint against its background to be seen
+// (a dark side before dark windows), the photos show the front face alone, and a box turned by θ*
+// about z_a and centred on the true front face's middle fits that: its diagonal then runs along
+// the front face, its ends where the face's corners are, the outline only √(1 + (d/w)²) − 1 wider
+// (2 % for a thin panel), in every photo of that side alike. The true pose is then the box turned
+// back by ∓θ* and moved by d/2 away from the photos along its own boresight: its outline meets
+// fewer edges (not the faint face's) but lies better on those it meets, and the selection weighs
+// the two by that placement (pose_selection.hpp). A fourth start comes from outside the photos: a
 // known mast, which a panel's back faces (pose_selection.hpp), turns the box to face it
 // (facing_turn). register_antenna refines and judges each start like any other proposal.
 #pragma once
@@ -47,6 +55,16 @@ std::vector<double> mirror_turns(const Iso3& T_board_antenna, const Vec3& outlin
 /// min_turn_deg of no turn or of a smaller one left out; smallest turn first.
 std::vector<Iso3> yaw_turns(const Iso3& T_board_antenna, const Vec3& outline_box_m,
                             const std::vector<Vec3>& viewpoints_board, const YawTurnOptions& options);
+
+/// The turns about z_a (rad, right-handed) to a box's crease twins (file comment): +θ* and −θ*, θ* =
+/// atan(d / w) for a box of `outline_box_m` (width w, depth d, height).
+std::vector<double> crease_turns(const Vec3& outline_box_m);
+
+/// `T_board_antenna` turned about its own long axis by each of its crease turns and moved by half the
+/// box's depth along the turned boresight, away from the viewpoints (file comment): the true pose
+/// where `T_board_antenna` lays its outline on a crease.
+std::vector<Iso3> crease_twins(const Iso3& T_board_antenna, const Vec3& outline_box_m,
+                               const std::vector<Vec3>& viewpoints_board);
 
 /// `T_board_antenna` turned about its own long axis z_a, by at most a quarter turn, until its
 /// boresight or its reverse lies in the plane of z_a and `direction_board` (a face, not an edge,
