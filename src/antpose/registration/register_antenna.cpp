@@ -30,6 +30,20 @@ bool same_place(const Iso3& T, const Iso3& U, double max_deg, double max_m = std
   return rad2deg(box_angle(T.linear(), U.linear())) < max_deg && (T.translation() - U.translation()).norm() < max_m;
 }
 
+// Whether one of `kept` stands where T puts the box (same_place).
+bool stands_among(const Iso3& T, const std::vector<Refined>& kept, double max_deg,
+                  double max_m = std::numeric_limits<double>::infinity()) {
+  return std::any_of(kept.begin(), kept.end(),
+                     [&](const Refined& k) { return same_place(T, k.candidate.T_board_antenna, max_deg, max_m); });
+}
+
+bool fits_better(const Refined& a, const Refined& b) { return a.outline.score < b.outline.score; }
+
+// The candidate whose outline fits best, or end() where there is none.
+std::vector<Refined>::iterator best_outline(std::vector<Refined>& kept) {
+  return std::min_element(kept.begin(), kept.end(), fits_better);
+}
+
 // Where the outline search starts the box's centre besides the rectangle's own fit: the region's
 // points' centroid.
 std::vector<Vec3> search_starts(const AntennaScene& s) {
@@ -151,8 +165,7 @@ bool passes_through_neighbour(const OrientedBox& box, const std::vector<Oriented
 // better evidence of the pose). Best outline first.
 std::vector<Refined> distinct_in_rectangle(std::vector<Refined> refined, const model::AntennaModel& model,
                                            const AntennaScene& s, const RegisterOptions& o) {
-  std::sort(refined.begin(), refined.end(),
-            [](const Refined& a, const Refined& b) { return a.outline.score < b.outline.score; });
+  std::sort(refined.begin(), refined.end(), fits_better);
   std::vector<Refined> out;
   for (auto& r : refined) {
     const Iso3& T = r.candidate.T_board_antenna;
@@ -174,14 +187,13 @@ std::vector<Refined> distinct_in_rectangle(std::vector<Refined> refined, const m
 std::vector<PoseCandidate> turned_proposals(const std::vector<Refined>& kept, const AntennaScene& s,
                                             const RegisterOptions& o) {
   std::vector<PoseCandidate> out;
-  const auto near = [&](const Iso3& T, const Iso3& U) { return same_place(T, U, o.turns.min_turn_deg); };
   for (std::size_t i = 0; i < std::min(kept.size(), o.turns.of_best); ++i) {
     for (const Iso3& T : yaw_turns(kept[i].candidate.T_board_antenna, model::outline_box(*kept[i].model),
                                    s.viewpoints_board, o.turns)) {
-      const bool known =
-          std::any_of(kept.begin(), kept.end(),
-                      [&](const Refined& k) { return near(T, k.candidate.T_board_antenna); }) ||
-          std::any_of(out.begin(), out.end(), [&](const PoseCandidate& c) { return near(T, c.T_board_antenna); });
+      const bool known = stands_among(T, kept, o.turns.min_turn_deg) ||
+                         std::any_of(out.begin(), out.end(), [&](const PoseCandidate& c) {
+                           return same_place(T, c.T_board_antenna, o.turns.min_turn_deg);
+                         });
       if (!known) out.push_back({T, Strategy::kTurned, {}, 0.0, nullptr});
     }
   }
@@ -198,10 +210,7 @@ std::optional<PoseCandidate> facing_mast_proposal(const std::vector<Refined>& ke
   const Iso3& best = kept.front().candidate.T_board_antenna;
   if (!side_on_to_mast(*s.mast, best, o.selection)) return std::nullopt;
   const auto T = facing_turn(best, best.translation() - s.mast->axis_point_board);
-  if (!T || std::any_of(kept.begin(), kept.end(), [&](const Refined& k) {
-        return same_place(*T, k.candidate.T_board_antenna, o.turns.min_turn_deg);
-      }))
-    return std::nullopt;
+  if (!T || stands_among(*T, kept, o.turns.min_turn_deg)) return std::nullopt;
   return PoseCandidate{*T, Strategy::kFacingMast, {}, 0.0, nullptr};
 }
 
@@ -259,13 +268,11 @@ std::vector<Refined> refine_and_turn(const std::shared_ptr<const model::AntennaM
   // slid one that descends back to a kept candidate's place found no other.
   auto more = refine_all(shared, s, turned, o);
   auto moved = refine_all(shared, s, slid, o);
-  const auto known = [&](const Refined& m, double max_m) {
-    return std::any_of(kept.begin(), kept.end(), [&](const Refined& k) {
-      return same_place(m.candidate.T_board_antenna, k.candidate.T_board_antenna, o.same_pose_deg, max_m);
-    });
-  };
-  std::erase_if(more, [&](const Refined& m) { return known(m, std::numeric_limits<double>::infinity()); });
-  std::erase_if(moved, [&](const Refined& m) { return known(m, o.same_pose_m); });
+  std::erase_if(more,
+                [&](const Refined& m) { return stands_among(m.candidate.T_board_antenna, kept, o.same_pose_deg); });
+  std::erase_if(moved, [&](const Refined& m) {
+    return stands_among(m.candidate.T_board_antenna, kept, o.same_pose_deg, o.same_pose_m);
+  });
   kept.insert(kept.end(), std::make_move_iterator(more.begin()), std::make_move_iterator(more.end()));
   kept.insert(kept.end(), std::make_move_iterator(moved.begin()), std::make_move_iterator(moved.end()));
   return distinct_in_rectangle(std::move(kept), *shared, s, o);
@@ -323,17 +330,15 @@ void fit_shapes(std::vector<Refined>& kept, const AntennaScene& s, const Registe
 // is profiled next (fit_shapes).
 void add_crease_twins(std::vector<Refined>& kept, const AntennaScene& s, const RegisterOptions& o) {
   if (!o.crease_twins || kept.empty()) return;
-  const auto best = std::min_element(
-      kept.begin(), kept.end(), [](const Refined& a, const Refined& b) { return a.outline.score < b.outline.score; });
-  const auto with = best->model;
+  const auto best_it = best_outline(kept);
+  const auto with = best_it->model;
+  const Iso3 best = best_it->candidate.T_board_antenna;
   std::vector<PoseCandidate> twins;
-  for (const Iso3& T : crease_twins(best->candidate.T_board_antenna, model::outline_box(*with), s.viewpoints_board))
+  for (const Iso3& T : crease_twins(best, model::outline_box(*with), s.viewpoints_board))
     twins.push_back({T, Strategy::kCreaseTwin, {}, 0.0, nullptr});
   auto placed = refine_all(with, s, twins, o);
   std::erase_if(placed, [&](const Refined& m) {
-    return std::any_of(kept.begin(), kept.end(), [&](const Refined& k) {
-      return same_place(m.candidate.T_board_antenna, k.candidate.T_board_antenna, o.same_pose_deg, o.same_pose_m);
-    });
+    return stands_among(m.candidate.T_board_antenna, kept, o.same_pose_deg, o.same_pose_m);
   });
   kept.insert(kept.end(), std::make_move_iterator(placed.begin()), std::make_move_iterator(placed.end()));
   kept = distinct_in_rectangle(std::move(kept), *with, s, o);
@@ -349,8 +354,7 @@ void add_crease_twins(std::vector<Refined>& kept, const AntennaScene& s, const R
 // weighed only as the mast's rival (PoseCandidate::faint_outline): they fill the rectangle as the
 // best does, and the mast speaks for them (pose_selection.hpp).
 void keep_fitting_outlines(std::vector<Refined>& kept, const AntennaScene& s, const RegisterOptions& o) {
-  const auto best = std::min_element(
-      kept.begin(), kept.end(), [](const Refined& a, const Refined& b) { return a.outline.score < b.outline.score; });
+  const auto best = best_outline(kept);
   const bool contradicted = s.mast && o.face_mast && best != kept.end() &&
                             best->outline.score <= o.max_faint_outline_score &&
                             side_on_to_mast(*s.mast, best->candidate.T_board_antenna, o.selection);
