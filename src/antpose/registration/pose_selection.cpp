@@ -174,8 +174,10 @@ Selection select_pose(const std::vector<PoseCandidate>& candidates, const std::v
   for (std::size_t k = 1; k < order.size(); ++k) {
     const auto& c = candidates[order[k]];
     if (c.faint_outline) continue;  // only ever the mast's rival
-    const double angle = boresight_angle(c.T_board_antenna.linear(), R_best);
-    if (angle >= M_PI - rival_min) continue;  // the winner turned round: front and back
+    // Turned round, a box lies where it lay (box_angle): a boresight a few degrees from the winner's
+    // reversed is a pose a few degrees from the winner's, its front and back decided apart.
+    const double boresights = boresight_angle(c.T_board_antenna.linear(), R_best);
+    const double angle = std::min(boresights, M_PI - boresights);
     const Comparison versus = compare_shape(candidates[s.best].evidence, c.evidence, evidence);
     // The same answer a few degrees off, or another: a boresight elsewhere.
     if (angle <= rival_min) {

@@ -1,8 +1,9 @@
 // Choosing an antenna's pose among candidates judged by the same evidence (pose_evidence.hpp).
 //
 // Shape first: the candidate with the lowest score wins; every other candidate whose boresight is
-// more than `rival_min_deg` from the winner's (its turned-round twin excepted: that is front and
-// back) and that the winner does not beat decisively is a rival — the photos and points do not
+// more than `rival_min_deg` from the winner's or from the winner's reversed (turned round about its
+// long axis, a box lies where it lay: front and back are decided apart, below) and that the winner
+// does not beat decisively is a rival — the photos and points do not
 // tell the two apart, and the answer must say so (a σ that covers both, or a refusal). A nearer
 // candidate the winner does not beat decisively (another local minimum a few degrees off) is the
 // same answer, but the σ must cover it too: a near rival. So is a nearer candidate whose outline
