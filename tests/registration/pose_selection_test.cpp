@@ -47,36 +47,23 @@ TEST(PoseSelection, AnotherYawThePhotosDoNotRuleOutIsARival) {
 }
 
 // A candidate a few degrees off that the photos do not rule out is the same answer (no rival, no
-// ambiguity), but its σ must cover it; one they rule out is left alone.
+// ambiguity), but its σ must cover it; one they rule out is left alone. Turned round about its long
+// axis a box lies where it lay: so too where the candidates face the other way (front and back are
+// decided apart).
 TEST(PoseSelection, ANearPoseThePhotosDoNotRuleOutIsANearRival) {
-  const std::vector<PoseCandidate> candidates{
-      facing(40, Vec3::Zero(), {0.10, 0.11, 0.09, 0.10, 0.12, 0.10}),
-      facing(43, Vec3::Zero(), {0.11, 0.10, 0.10, 0.11, 0.11, 0.10}),   // about as good: near rival
-      facing(36, Vec3::Zero(), {0.30, 0.32, 0.29, 0.31, 0.33, 0.30})};  // clearly worse
-  const std::vector<PoseEvidence> twins(candidates.size(), side({0.0, 0.0}));
-  const Selection s = select_pose(candidates, twins, std::nullopt, {}, {});
-  EXPECT_EQ(s.best, 0u);
-  EXPECT_TRUE(s.rivals.empty());
-  EXPECT_FALSE(s.runner_up);
-  ASSERT_EQ(s.near_rivals.size(), 1u);
-  EXPECT_EQ(s.near_rivals[0], 1u);
-}
-
-// A box turned round about its long axis lies where it lay: a candidate facing a few degrees from the
-// winner's reverse is a pose a few degrees off, and its σ must cover it as well; front and back are
-// decided apart.
-TEST(PoseSelection, ANearPoseFacingTheOtherWayIsANearRival) {
-  const std::vector<PoseCandidate> candidates{
-      facing(40, Vec3::Zero(), {0.10, 0.11, 0.09, 0.10, 0.12, 0.10}),
-      facing(226, Vec3::Zero(), {0.11, 0.10, 0.10, 0.11, 0.11, 0.10}),   // about as good: near rival
-      facing(215, Vec3::Zero(), {0.30, 0.32, 0.29, 0.31, 0.33, 0.30})};  // clearly worse
-  const std::vector<PoseEvidence> twins(candidates.size(), side({0.0, 0.0}));
-  const Selection s = select_pose(candidates, twins, std::nullopt, {}, {});
-  EXPECT_EQ(s.best, 0u);
-  EXPECT_TRUE(s.rivals.empty());
-  EXPECT_FALSE(s.runner_up);
-  ASSERT_EQ(s.near_rivals.size(), 1u);
-  EXPECT_EQ(s.near_rivals[0], 1u);
+  for (const double turn : {0.0, 180.0}) {
+    const std::vector<PoseCandidate> candidates{
+        facing(40, Vec3::Zero(), {0.10, 0.11, 0.09, 0.10, 0.12, 0.10}),
+        facing(43 + turn, Vec3::Zero(), {0.11, 0.10, 0.10, 0.11, 0.11, 0.10}),   // about as good: near rival
+        facing(36 + turn, Vec3::Zero(), {0.30, 0.32, 0.29, 0.31, 0.33, 0.30})};  // clearly worse
+    const std::vector<PoseEvidence> twins(candidates.size(), side({0.0, 0.0}));
+    const Selection s = select_pose(candidates, twins, std::nullopt, {}, {});
+    EXPECT_EQ(s.best, 0u) << turn;
+    EXPECT_TRUE(s.rivals.empty()) << turn;
+    EXPECT_FALSE(s.runner_up) << turn;
+    ASSERT_EQ(s.near_rivals.size(), 1u) << turn;
+    EXPECT_EQ(s.near_rivals[0], 1u) << turn;
+  }
 }
 
 // Where a stretch of the true outline is too faint to be seen, a pose a few degrees off that lays
