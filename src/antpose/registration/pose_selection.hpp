@@ -3,23 +3,23 @@
 // Shape first: the candidate with the lowest score wins; every other candidate whose boresight is
 // more than `rival_min_deg` from the winner's or from the winner's reversed (turned round about its
 // long axis, a box lies where it lay: front and back are decided apart, below) and that the winner
-// does not beat decisively is a rival — the photos and points do not
-// tell the two apart, and the answer must say so (a σ that covers both, or a refusal). A nearer
-// candidate the winner does not beat decisively (another local minimum a few degrees off) is the
-// same answer, but the σ must cover it too: a near rival. So is a nearer candidate whose outline
-// lies better on the edges it meets than the winner's, by more than that comparison's standard
-// error (pose_evidence.hpp: where part of the true outline is too faint to be seen, a pose laying
-// its outline on a crease meets more edges and scores lower in every photo alike). A candidate
-// further off is also a rival, however decisively the winner beats it at the nominal weight, where
-// it ranks first with the points weighed against the outline at either end of the range that
-// weight is known within (EvidenceOptions::points_weight_range): the crease error above, or a
-// mount's points taken for the panel's, is common to every unit of one half and escapes the
-// comparison's noise, so where the two halves point to different poses, the winner must stay first
-// at every weight. The noise test stays at the nominal weight: at the ends of the range one half's
-// scatter swamps the other's, and a margin that is real would read as noise there. A crease twin of
-// the winner (yaw_turns.hpp: turned by atan(depth / width), where a faint side face lets a box lay
-// its outline on the crease) is that crease error at its full size, often beyond rival_min_deg: it
-// is a rival wherever its placement leans to it as a near candidate's would.
+// does not beat decisively is a rival — the photos and points do not tell the two apart, and the
+// answer must say so (a σ that covers both, or a refusal). A nearer candidate the winner does not
+// beat decisively (another local minimum a few degrees off) is the same answer, but the σ must
+// cover it too: a near rival. So is a nearer candidate whose outline lies better on the edges it
+// meets than the winner's, by more than that comparison's standard error (pose_evidence.hpp: where
+// part of the true outline is too faint to be seen, a pose laying its outline on a crease meets
+// more edges and scores lower in every photo alike). A candidate further off is also a rival,
+// however decisively the winner beats it at the nominal weight, where it ranks first with the
+// points weighed against the outline at either end of the range that weight is known within
+// (EvidenceOptions::points_weight_range): the crease error above, or a mount's points taken for the
+// panel's, is common to every unit of one half and escapes the comparison's noise, so where the two
+// halves point to different poses, the winner must stay first at every weight. The noise test stays
+// at the nominal weight: at the ends of the range one half's scatter swamps the other's, and a
+// margin that is real would read as noise there. A crease twin of the winner (yaw_turns.hpp: turned
+// by atan(depth / width), where a faint side face lets a box lay its outline on the crease) is that
+// crease error at its full size, often beyond rival_min_deg: it is a rival wherever its placement
+// leans to it as a near candidate's would.
 // Then front and back, which the box's outline cannot tell: the winner against its twin turned
 // by 180° about its long axis. A known mast decides first where it stands clearly behind one of
 // them (a panel's back plate faces its mount); otherwise the side units (the vertical structure
