@@ -101,6 +101,10 @@ TEST(AntennaAttitude, ARivalsWideningIsItsOwnShare) {
   EXPECT_NEAR(*rival.sigma.azimuth, deg2rad(10.0), 1e-9);
   EXPECT_NEAR(std::hypot(*before.azimuth, *rival.sigma.azimuth), *m.result.sigma.azimuth, 1e-12);
   EXPECT_NEAR(rival.sigma.downtilt, 0.0, 1e-9);
+  // A second widening, by another kind of rival, joins the budget under its own name.
+  widen_for_rivals(m.result, m.R_board_antenna, {R_rival}, m.board, "face points against the outline");
+  ASSERT_EQ(m.result.budget.size(), sources + 2);
+  EXPECT_EQ(m.result.budget.back().source, "face points against the outline");
 }
 
 TEST(AntennaAttitude, NoRivalNoWidening) {

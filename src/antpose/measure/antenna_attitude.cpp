@@ -30,7 +30,7 @@ AntennaAttitudeResult antenna_attitude(const BoardWorldAttitude& board, const Ma
 }
 
 double widen_for_rivals(AntennaAttitudeResult& at, const Mat3& R_result, const std::vector<Mat3>& rivals_board,
-                        const BoardWorldAttitude& board) {
+                        const BoardWorldAttitude& board, const std::string& source) {
   const auto widen = [](auto& sigma, double difference) {
     if (sigma) sigma = std::hypot(*sigma, difference / 2);
   };
@@ -61,7 +61,7 @@ double widen_for_rivals(AntennaAttitudeResult& at, const Mat3& R_result, const s
     const auto added_to = [&](const std::optional<double>& now, const std::optional<double>& was) {
       return now && was ? std::optional<double>(added(*now, *was)) : std::nullopt;
     };
-    at.budget.push_back({"rival poses",
+    at.budget.push_back({source,
                          {added_to(at.sigma.azimuth, before.azimuth), added(at.sigma.downtilt, before.downtilt),
                           added_to(at.sigma.roll, before.roll)}});
   }

@@ -56,9 +56,10 @@ AntennaAttitudeResult antenna_attitude(const BoardWorldAttitude& board, const Ma
 /// angle takes the larger of its differences to the rival and to R_board_antenna turned by the
 /// rival's boresight angle about its own z (a panel 3.9° down, 13.8° off about its own axis,
 /// reads as −0.99° of roll, where a rival 30° round about the vertical would leave the roll's σ
-/// at 0.18°). The widening joins the budget as "rival poses". Returns the largest angle between the
+/// at 0.18°). The widening joins the budget as `source`. Returns the largest angle between the
 /// rivals' boresights and the result's (rad).
 double widen_for_rivals(AntennaAttitudeResult& result, const Mat3& R_board_antenna,
-                        const std::vector<Mat3>& rivals_board, const BoardWorldAttitude& board);
+                        const std::vector<Mat3>& rivals_board, const BoardWorldAttitude& board,
+                        const std::string& source = "rival poses");
 
 }  // namespace antpose::measure

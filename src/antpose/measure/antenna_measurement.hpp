@@ -82,6 +82,8 @@ struct AntennaMeasurement {
   Vec3 p_board_antenna = Vec3::Zero();       // m
   std::vector<UncertaintySource> cov_board;  // the registration's rotation covariance by source, board frame
   std::vector<Mat3> rivals_board;            // other poses the evidence does not rule out
+  std::vector<Mat3> face_rivals_board;       // the result laid on its faces' points where they disagree with it
+  std::vector<registration::FacePlane> face_planes;  // the faces' planes (registration/face_plane.hpp)
   registration::RegistrationVerdict verdict = registration::RegistrationVerdict::kUnique;
   std::optional<registration::Comparison> runner_up;  // the result against the best other pose
   /// Where the result turns a side face to the mast: it against the best pose that faces the mast.

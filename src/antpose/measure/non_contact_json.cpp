@@ -104,7 +104,16 @@ nlohmann::json antenna_json(const AntennaMeasurement& m) {
                      {"p_board_antenna_m",
                       {c.T_board_antenna.translation().x(), c.T_board_antenna.translation().y(),
                        c.T_board_antenna.translation().z()}}});
+  nlohmann::json faces = nlohmann::json::array();
+  for (const auto& f : m.face_planes)
+    faces.push_back({{"face", registration::face_name(f.normal_antenna)},
+                     {"points", f.points},
+                     {"rms_m", f.rms_m},
+                     {"turn_deg", rad2deg(f.turn_board.norm())},
+                     {"chi2", f.chi2},
+                     {"disagrees", f.disagrees}});
   a["registration"] = {{"candidates", m.candidates},
+                       {"face_planes", faces},
                        {"poses", poses},
                        {"rivals", m.rivals_board.size()},
                        {"runner_up", comparison_json(m.runner_up)},

@@ -456,6 +456,27 @@ AntennaRegistration select(const AntennaScene& s, std::vector<Refined> kept, con
   return out;
 }
 
+// The result's faces against the region's points (face_plane.hpp): each plane that disagrees
+// with the outline adds its pose as one the σ covers, and a warning.
+void check_faces(AntennaRegistration& out, const model::AntennaModel& model, const AntennaScene& s,
+                 const RegisterOptions& o) {
+  const double radius = model.panel ? model.panel->edge_radius_m : 0.0;
+  out.face_planes = fit_face_planes(s.points_board, out.T_board_antenna, model.size_m, radius, s.viewpoints_board,
+                                    out.rotation_covariance_board(), o.face_plane);
+  for (const auto& plane : out.face_planes) {
+    if (!plane.disagrees) continue;
+    Iso3 T = out.T_board_antenna;
+    T.linear() = exp_so3(plane.turn_board) * T.linear();
+    out.face_rivals.push_back(T);
+    out.warnings.push_back(fmt::format(
+        "the region's points on the panel's {} face lie at {:.1f}° to the registered face (χ² {:.0f}, more than "
+        "its σ and the outline's allow): the outline or the points are biased, and these photos do not say which "
+        "(an oblique view of a narrow or ribbed face biases the points; arms and clamps the model lacks bias the "
+        "outline); the σ covers both; photos facing that face more squarely would settle it",
+        face_name(plane.normal_antenna), rad2deg(plane.turn_board.norm()), plane.chi2));
+  }
+}
+
 void check_scene(const AntennaScene& s) {
   if (s.views.empty() || s.region_view >= s.views.size() || s.areas.size() != s.views.size() ||
       s.viewpoints_board.size() != s.views.size())
@@ -487,6 +508,7 @@ OptionProblems RegisterOptions::Check() const {
   p.nest("selection", selection.Check());
   p.nest("panel_shape", panel_shape.Check());
   p.nest("mount_search", mount_search.Check());
+  p.nest("face_plane", face_plane.Check());
   p.require(refine_candidates >= 1, "refine_candidates", "at least 1");
   p.require(same_pose_deg >= 0 && same_pose_m >= 0, "same_pose_deg, same_pose_m", "≥ 0");
   p.require(neighbour_clearance_m >= 0, "neighbour_clearance_m", "≥ 0");
@@ -563,6 +585,7 @@ AntennaRegistration register_antenna(const model::AntennaModel& model, const Ant
   }
   auto out = select(s, std::move(kept), o);
   out.proposed = proposals.size();
+  check_faces(out, out.panel_shape ? out.panel_shape->model : model, s, o);
   if (out.outline_score > o.max_outline_score)
     out.warnings.push_back(fmt::format(
         "the model's outline meets the photos' edges only faintly (score {:.2f}; a clearly seen antenna scores "

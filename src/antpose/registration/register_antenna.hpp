@@ -40,6 +40,7 @@
 #include "antpose/reconstruction/mast.hpp"
 #include "antpose/reconstruction/mast_search.hpp"
 #include "antpose/registration/axis_slide.hpp"
+#include "antpose/registration/face_plane.hpp"
 #include "antpose/registration/global_start.hpp"
 #include "antpose/registration/outline_search.hpp"
 #include "antpose/registration/pose_evidence.hpp"
@@ -95,6 +96,7 @@ struct RegisterOptions {
   SelectionOptions selection;
   ShapeOptions panel_shape;                        // the best candidates' shape profiled (shape_fit.hpp)
   reconstruction::MastSearchOptions mount_search;  // vertical structure behind and before the best
+  FacePlaneOptions face_plane;                     // the result's faces checked against its points (face_plane.hpp)
   std::size_t shape_candidates = 3;                // that many, by their outline
   double same_pose_deg = 2.0, same_pose_m = 0.03;  // refined candidates this close are one
   double min_roi_fill = 0.3;
@@ -133,6 +135,10 @@ struct AntennaRegistration {
   RegistrationVerdict verdict = RegistrationVerdict::kUnique;
   std::vector<Iso3> rivals;       // other poses the evidence does not rule out (front and back as decided)
   std::vector<Iso3> near_rivals;  // poses within a few degrees it does not rule out: the σ covers them
+  /// The planes of the faces the points show (face_plane.hpp), and the pose laid on each plane
+  /// that disagrees with the outline: the σ covers those too.
+  std::vector<FacePlane> face_planes;
+  std::vector<Iso3> face_rivals;
   Selection selection;
   std::vector<PoseCandidate> candidates;  // refined, distinct, with their evidence
   std::size_t proposed = 0;               // candidates the strategies proposed
