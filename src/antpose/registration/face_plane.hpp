@@ -13,20 +13,19 @@
 // by several degrees), only evidence that the outline may be off by as much.
 //
 // On each long face (±x_a, ±y_a) the photos see, the region's points within `gate_m` of its
-// registered plane, over its flat part (inside the edge rounding, away from
-// the end caps), are fitted by least squares with depth d = c₀ + b·u + c·v (u along the long axis
-// z_a, v across the face, (u, v, n) right-handed), re-gated at `inlier_sigmas` × their RMS. A
-// small turn ω of the true face against the registered one (antenna frame) gives b = −ω·e_v and
-// c = ω·e_u, so the fit measures the turn's two components in the face's plane (the one about its
-// normal is not seen). The slopes' covariance is the fit's σ²(AᵀA)⁻¹, inflated by n/n_eff for
-// neighbouring stereo points' correlation (one independent point per correlation_m², as the
-// dense matching's window spreads one error over its neighbours), plus the face's own deviation
-// from a plane (`flatness_m`) over its extent. The disagreement is χ² = sᵀ(C_s + H Σ Hᵀ)⁻¹s of the
-// slopes s against the outline's rotation covariance Σ carried into slope space.
+// registered plane, over its flat part (inside the edge rounding, away from the end caps), are
+// fitted by least squares with depth d = c₀ + b·u + c·v (u along the long axis z_a, v across the
+// face, (u, v, n) right-handed), re-gated at `inlier_sigmas` × their RMS. A small turn ω of the
+// true face against the registered one (antenna frame) gives b = −ω·e_v and c = ω·e_u, so the fit
+// measures the turn's two components in the face's plane (the one about its normal is not seen).
+// The slopes' covariance C_s is the fit's σ²(AᵀA)⁻¹, inflated by n/n_eff for neighbouring stereo
+// points' correlation (one independent point per correlation_m², as the dense matching's window
+// spreads one error over its neighbours), plus the face's own deviation from a plane
+// (`flatness_m`) over its extent. The disagreement is χ² = sᵀ(C_s + H Σ Hᵀ)⁻¹s of the slopes s
+// against the outline's rotation covariance Σ carried into slope space (H: ω to the slopes).
 #pragma once
 
 #include <cstddef>
-#include <optional>
 #include <string>
 #include <vector>
 
