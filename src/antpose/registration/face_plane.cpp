@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <optional>
+#include <set>
 #include <string>
+#include <utility>
 
 namespace antpose::registration {
 namespace {
@@ -38,16 +40,18 @@ std::vector<Face> seen_faces(const Iso3& T_board_antenna, const Vec3& size_m, do
 }
 
 // The plane d = c₀ + b·u + c·v through the (u, v, d) points: coefficients, the inverse normal
-// matrix, the residual variance, and the points' extent along u and v.
+// matrix, the residual variance, the points' extent along u and v, and how many `cell_m` squares
+// of the face they occupy.
 struct PlaneFit {
   Vec3 coefficients = Vec3::Zero();
   Mat3 normal_inverse = Mat3::Zero();
   double variance = 0.0;
   double span_u = 0.0, span_v = 0.0;
   std::size_t n = 0;
+  std::size_t cells = 0;  // correlation_m squares the points occupy
 };
 
-std::optional<PlaneFit> least_squares(const std::vector<Vec3>& uvd) {
+std::optional<PlaneFit> least_squares(const std::vector<Vec3>& uvd, double cell_m) {
   if (uvd.size() < 4) return std::nullopt;
   Mat3 AtA = Mat3::Zero();
   Vec3 Atd = Vec3::Zero();
@@ -68,6 +72,10 @@ std::optional<PlaneFit> least_squares(const std::vector<Vec3>& uvd) {
   f.n = uvd.size();
   f.variance = ss / static_cast<double>(f.n - 3);
   f.span_u = hi.x() - lo.x(), f.span_v = hi.y() - lo.y();
+  std::set<std::pair<long, long>> cells;
+  for (const Vec3& p : uvd)
+    cells.emplace(std::lround(std::floor(p.x() / cell_m)), std::lround(std::floor(p.y() / cell_m)));
+  f.cells = cells.size();
   return f;
 }
 
@@ -87,7 +95,7 @@ std::optional<PlaneFit> fit_face(const std::vector<Vec3>& points_antenna, const 
     std::vector<Vec3> in;
     for (const Vec3& p : all)
       if (std::abs(p.z() - plane.dot(Vec3(1.0, p.x(), p.y()))) < gate) in.push_back(p);
-    fit = least_squares(in);
+    fit = least_squares(in, o.correlation_m);
     if (!fit) return std::nullopt;
     plane = fit->coefficients;
     gate = std::max(o.min_gate_m, o.inlier_sigmas * std::sqrt(fit->variance));
@@ -102,8 +110,7 @@ std::optional<FacePlane> face_plane(const std::vector<Vec3>& points_antenna, con
   if (!fit || fit->n < o.min_points || fit->span_u < o.min_cover_fraction * 2 * face.half_u ||
       fit->span_v < o.min_cover_fraction * 2 * face.half_v || std::sqrt(fit->variance) > o.max_rms_m)
     return std::nullopt;
-  const double n_eff = std::clamp(fit->span_u * fit->span_v / (o.correlation_m * o.correlation_m), 1.0,
-                                  static_cast<double>(fit->n));
+  const double n_eff = static_cast<double>(std::min(fit->n, fit->cells));
   Eigen::Matrix2d slopes_cov = fit->variance * fit->normal_inverse.bottomRightCorner<2, 2>() * (fit->n / n_eff);
   slopes_cov(0, 0) += std::pow(o.flatness_m / (fit->span_u / 2), 2);
   slopes_cov(1, 1) += std::pow(o.flatness_m / (fit->span_v / 2), 2);

@@ -19,9 +19,10 @@
 // true face against the registered one (antenna frame) gives b = −ω·e_v and c = ω·e_u, so the fit
 // measures the turn's two components in the face's plane (the one about its normal is not seen).
 // The slopes' covariance C_s is the fit's σ²(AᵀA)⁻¹, inflated by n/n_eff for neighbouring stereo
-// points' correlation (one independent point per correlation_m², as the dense matching's window
-// spreads one error over its neighbours), plus the face's own deviation from a plane
-// (`flatness_m`) over its extent. The disagreement is χ² = sᵀ(C_s + H Σ Hᵀ)⁻¹s of the slopes s
+// points' correlation: n_eff counts the correlation_m squares of the face the points occupy (the
+// dense matching's window spreads one error over its neighbours, and points bunched on a plain
+// radome's few details are few measurements however many they are), plus the face's own deviation
+// from a plane (`flatness_m`) over its extent. The disagreement is χ² = sᵀ(C_s + H Σ Hᵀ)⁻¹s of the slopes s
 // against the outline's rotation covariance Σ carried into slope space (H: ω to the slopes).
 #pragma once
 
