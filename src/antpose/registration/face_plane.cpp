@@ -20,10 +20,7 @@ struct Face {
 // The long faces whose outward normal points towards the mean viewpoint.
 std::vector<Face> seen_faces(const Iso3& T_board_antenna, const Vec3& size_m, double edge_radius_m,
                              const std::vector<Vec3>& viewpoints_board, const FacePlaneOptions& o) {
-  Vec3 mean = Vec3::Zero();
-  for (const Vec3& v : viewpoints_board) mean += v;
-  mean /= static_cast<double>(viewpoints_board.size());
-  const Vec3 towards = T_board_antenna.linear().transpose() * (mean - T_board_antenna.translation());
+  const Vec3 towards = T_board_antenna.inverse() * centroid(viewpoints_board);
   std::vector<Face> out;
   for (const int axis : {0, 1})
     for (const double sign : {1.0, -1.0}) {
@@ -154,9 +151,7 @@ std::vector<FacePlane> fit_face_planes(const PointCloud& points_board, const Iso
   throw_unless_ok(o.Check(), "FacePlaneOptions");
   std::vector<FacePlane> out;
   if (!o.enabled || points_board.empty() || viewpoints_board.empty()) return out;
-  std::vector<Vec3> points_antenna;
-  const Iso3 T_antenna_board = T_board_antenna.inverse();
-  for (const Vec3& p : points_board.points) points_antenna.push_back(T_antenna_board * p);
+  const auto points_antenna = transformed(points_board, T_board_antenna.inverse()).points;
   for (const Face& face : seen_faces(T_board_antenna, size_m, edge_radius_m, viewpoints_board, o))
     if (auto plane = face_plane(points_antenna, face, T_board_antenna.linear(), outline_covariance_board, o))
       out.push_back(*plane);
@@ -164,7 +159,7 @@ std::vector<FacePlane> fit_face_planes(const PointCloud& points_board, const Iso
 }
 
 std::string face_name(const Vec3& normal_antenna) {
-  const int axis = normal_antenna.cwiseAbs().maxCoeff() == std::abs(normal_antenna.x()) ? 0 : 1;
+  const int axis = std::abs(normal_antenna.x()) > std::abs(normal_antenna.y()) ? 0 : 1;
   return std::string(normal_antenna[axis] >= 0 ? "+" : "-") + (axis == 0 ? "x" : "y");
 }
 
