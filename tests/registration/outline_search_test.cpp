@@ -76,6 +76,33 @@ TEST(OutlineSearch, FindsThePanelFromTheRectangleHoweverItIsDrawn) {
   }
 }
 
+// A thin panel in a loose rectangle, its margins a share of the panel's length as a user draws
+// them: it fills a quarter of the rectangle's area but spans most of its larger side, and fits;
+// a box beside it, or one a third as long, does not.
+TEST(OutlineSearch, TakesTheRectangleByItsLargerSide) {
+  const auto box = [](double x0, double y0, double x1, double y1) {
+    return Eigen::AlignedBox2d(Vec2(x0, y0), Vec2(x1, y1));
+  };
+  const Eigen::AlignedBox2d panel = box(100, 100, 550, 160);  // 450 × 60 px
+  const double m = 0.15 * 450;
+  const cv::Rect roi(static_cast<int>(100 - m), static_cast<int>(100 - m), static_cast<int>(450 + 2 * m),
+                     static_cast<int>(60 + 2 * m));
+  const auto fit = rectangle_fit(panel, roi);
+  EXPECT_TRUE(fit.centred);
+  EXPECT_NEAR(fit.span, 450.0 / roi.width, 0.01);
+  EXPECT_LT(panel.volume() / (roi.width * roi.height), 0.3);
+  EXPECT_GT(fit.span, OutlineSearchInput{}.min_roi_span);
+  // Beside it: half of it in the rectangle, its centre out.
+  EXPECT_FALSE(rectangle_fit(box(100, 180, 550, 380), roi).centred);
+  EXPECT_LT(rectangle_fit(box(250, 100, 400, 160), roi).span, OutlineSearchInput{}.min_roi_span);
+  // A tall rectangle is taken along its height; a box outside it spans nothing.
+  const cv::Rect tall(0, 0, 100, 400);
+  EXPECT_NEAR(rectangle_fit(box(40, 50, 60, 350), tall).span, 0.75, 0.01);
+  const auto outside = rectangle_fit(box(500, 500, 600, 600), tall);
+  EXPECT_EQ(outside.span, 0.0);
+  EXPECT_FALSE(outside.centred);
+}
+
 // A pose proposed by its orientation, its centre a panel's depth and more off (a turn about another
 // orientation's centre): placed by the outline, the box lands on the panel; a start placed where
 // the panel is stays there.

@@ -127,16 +127,16 @@ void settle_front_back(std::vector<AntennaMeasurement>& antennas, const NonConta
 }
 
 // Two rectangles whose registrations settled on one panel: the one whose rectangle the panel
-// fills less measured its neighbour, and says so.
+// spans less of measured its neighbour, and says so.
 void refuse_shared_panels(std::vector<AntennaMeasurement>& antennas, const NonContactSetup& setup,
                           const CameraPoses& poses) {
-  const auto fill = [&](const AntennaMeasurement& m, const model::AntennaModel& model) {
+  const auto span = [&](const AntennaMeasurement& m, const model::AntennaModel& model) {
     const Iso3 T = m.T_board_antenna();
     const cv::Rect roi(m.roi.roi.x, m.roi.roi.y, m.roi.roi.width, m.roi.roi.height);
     registration::SilhouetteView v;
     v.R_camera_board = poses.views[m.region_view].R_camera_board;
     v.t_camera_board = poses.views[m.region_view].t_camera_board;
-    return registration::roi_fill(model.size_m, T, v, poses.intrinsics, roi).first;
+    return registration::roi_span(model.size_m, T, v, poses.intrinsics, roi).span;
   };
   for (std::size_t a = 0; a < antennas.size(); ++a)
     for (std::size_t b = a + 1; b < antennas.size(); ++b) {
@@ -147,7 +147,7 @@ void refuse_shared_panels(std::vector<AntennaMeasurement>& antennas, const NonCo
       if (A.error || B.error || !ma || !mb) continue;
       const double apart = (A.p_board_antenna - B.p_board_antenna).norm();
       if (apart > 0.5 * std::min(ma->size_m.x(), mb->size_m.x())) continue;
-      const bool a_lost = fill(A, *ma) < fill(B, *mb);
+      const bool a_lost = span(A, *ma) < span(B, *mb);
       auto& lost = a_lost ? A : B;
       lost.error = fmt::format(
           "its rectangle's registration settled on the same panel as antenna {} ({:.2f} m apart): another panel "

@@ -80,7 +80,7 @@ std::optional<std::pair<Vec3, double>> filling_start(const OutlineSearchInput& i
 }
 
 // How much of the rectangle the antenna fills is the user's habit: from all of its larger side
-// down to the least that still covers `min_roi_fill` of it. The box's centre is swept along the
+// down to the least that still spans `min_roi_span` of it. The box's centre is swept along the
 // rectangle's centre ray over those depths, each step moving the box's ends by about the
 // chamfer's truncation (so that no depth falls between two samples' basins), and the best start
 // kept: a single guessed fill leaves a long box's ends outside the truncation, with no gradient.
@@ -90,7 +90,7 @@ std::optional<Vec3> swept_start(const BoxOutlineCost& cost, const OutlineSearchI
   const auto full = filling_start(in, K, R, 1.0);
   if (!full) return std::nullopt;
   const double length_map_px = full->second * cost.map_scale();
-  const double least = std::sqrt(in.min_roi_fill);
+  const double least = in.min_roi_span;
   const double ratio = std::max(1.0 + 2.0 * o.truncation_px / std::max(1.0, length_map_px),
                                 std::pow(1.0 / least, 1.0 / static_cast<double>(o.max_depth_starts)));
   std::optional<Vec3> best;
@@ -256,10 +256,8 @@ bool BoxOutlineCost::fits_rectangle(const std::array<Vec3, 8>& corners_board) co
     if (!uv) return false;
     box.extend(*uv);
   }
-  const cv::Rect& r = *input_.roi;
-  const Eigen::AlignedBox2d rect(Vec2(r.x - 0.5, r.y - 0.5), Vec2(r.x + r.width - 0.5, r.y + r.height - 0.5));
-  const Eigen::AlignedBox2d cut = box.intersection(rect);
-  return rect.contains(box.center()) && !cut.isEmpty() && cut.volume() >= input_.min_roi_fill * rect.volume();
+  const auto fit = rectangle_fit(box, *input_.roi);
+  return fit.centred && fit.span >= input_.min_roi_span;
 }
 
 std::pair<double, std::size_t> BoxOutlineCost::operator()(const Iso3& T_board_antenna) const {
@@ -324,6 +322,15 @@ void check_input(const OutlineSearchInput& input, const OutlineSearchOptions& op
 }
 
 }  // namespace
+
+RectangleFit rectangle_fit(const Eigen::AlignedBox2d& projected_px, const cv::Rect& roi) {
+  const Eigen::AlignedBox2d rect(Vec2(roi.x - 0.5, roi.y - 0.5),
+                                 Vec2(roi.x + roi.width - 0.5, roi.y + roi.height - 0.5));
+  const Eigen::AlignedBox2d cut = projected_px.intersection(rect);
+  if (cut.isEmpty()) return {0.0, false};
+  const int along = roi.width >= roi.height ? 0 : 1;
+  return {cut.sizes()[along] / rect.sizes()[along], rect.contains(projected_px.center())};
+}
 
 OutlineSearchResult search_box_outline(const OutlineSearchInput& input, const camera::CameraIntrinsics& intrinsics,
                                        const OutlineSearchOptions& options) {

@@ -62,11 +62,23 @@ struct OutlineSearchInput {
   double expected_width_px = 0;  // the box's width in that photo at full resolution (sets the maps' scale)
   Vec3 up_board = Vec3::UnitZ();
   std::vector<Vec3> starts_board;  // box centres to search from (board frame)
-  /// The user's rectangle in the region view: a pose whose projected box covers less than
-  /// `min_roi_fill` of it, or whose centre lies outside it, is not this antenna (cost 1).
+  /// The user's rectangle in the region view: a pose whose projected box spans less than
+  /// `min_roi_span` of its larger side, or whose centre lies outside it, is not this antenna
+  /// (cost 1; rectangle_fit).
   std::optional<cv::Rect> roi;
-  double min_roi_fill = 0.3;
+  double min_roi_span = 0.55;
 };
+
+/// How a box's projection (its corners' bounding box, px) stands in the user's rectangle: the
+/// share of the rectangle's larger side that it spans inside the rectangle, and whether its centre
+/// lies in it. The larger side, not the area: a user's margin goes with the antenna's length, so a
+/// thin panel drawn with a loose rectangle fills little of its area (60 px wide and 450 px long,
+/// with margins of 15 % of the length: 27 %) but most of its length.
+struct RectangleFit {
+  double span = 0.0;
+  bool centred = false;
+};
+RectangleFit rectangle_fit(const Eigen::AlignedBox2d& projected_px, const cv::Rect& roi);
 
 struct OutlineCandidate {
   Iso3 T_board_antenna = Iso3::Identity();  // the box's pose (which way round is not decided)

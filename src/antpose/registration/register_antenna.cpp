@@ -61,7 +61,7 @@ OutlineSearchInput outline_input(const model::AntennaModel& model, const Antenna
   in.up_board = s.up_board;
   in.starts_board = search_starts(s);
   in.roi = s.roi;
-  in.min_roi_fill = o.min_roi_fill;
+  in.min_roi_span = o.min_roi_span;
   return in;
 }
 
@@ -169,8 +169,8 @@ std::vector<Refined> distinct_in_rectangle(std::vector<Refined> refined, const m
   std::vector<Refined> out;
   for (auto& r : refined) {
     const Iso3& T = r.candidate.T_board_antenna;
-    const auto [fill, centred] = roi_fill(model.size_m, T, s.views[s.region_view], s.intrinsics, s.roi);
-    if (fill < o.min_roi_fill || !centred) continue;
+    const auto fit = roi_span(model.size_m, T, s.views[s.region_view], s.intrinsics, s.roi);
+    if (fit.span < o.min_roi_span || !fit.centred) continue;
     if (passes_through_neighbour({T, model.size_m}, s.neighbours_board, o.neighbour_clearance_m)) continue;
     const auto known = std::find_if(out.begin(), out.end(), [&](const Refined& k) {
       return same_place(T, k.candidate.T_board_antenna, o.same_pose_deg, o.same_pose_m);
@@ -512,24 +512,21 @@ OptionProblems RegisterOptions::Check() const {
   p.require(refine_candidates >= 1, "refine_candidates", "at least 1");
   p.require(same_pose_deg >= 0 && same_pose_m >= 0, "same_pose_deg, same_pose_m", "≥ 0");
   p.require(neighbour_clearance_m >= 0, "neighbour_clearance_m", "≥ 0");
-  p.require(min_roi_fill >= 0 && min_roi_fill <= 1, "min_roi_fill", "in [0, 1]");
+  p.require(min_roi_span > 0 && min_roi_span <= 1, "min_roi_span", "in (0, 1]");
   p.require(max_outline_score > 0 && max_outline_score <= max_faint_outline_score && max_faint_outline_score <= 1,
             "max_outline_score, max_faint_outline_score", "0 < max_outline_score ≤ max_faint_outline_score ≤ 1");
   return p;
 }
 
-std::pair<double, bool> roi_fill(const Vec3& size_m, const Iso3& T_board_antenna, const SilhouetteView& view,
-                                 const camera::CameraIntrinsics& K, const cv::Rect& roi) {
+RectangleFit roi_span(const Vec3& size_m, const Iso3& T_board_antenna, const SilhouetteView& view,
+                      const camera::CameraIntrinsics& K, const cv::Rect& roi) {
   Eigen::AlignedBox2d box;
   for (const Vec3& corner : model::box_corners(size_m)) {
     const auto uv = K.project(view.R_camera_board * (T_board_antenna * corner) + view.t_camera_board);
-    if (!uv) return {0.0, false};
+    if (!uv) return {};
     box.extend(*uv);
   }
-  const Eigen::AlignedBox2d rect(Vec2(roi.x - 0.5, roi.y - 0.5),
-                                 Vec2(roi.x + roi.width - 0.5, roi.y + roi.height - 0.5));
-  const Eigen::AlignedBox2d cut = box.intersection(rect);
-  return {cut.isEmpty() ? 0.0 : cut.volume() / rect.volume(), rect.contains(box.center())};
+  return rectangle_fit(box, roi);
 }
 
 std::vector<PoseCandidate> propose_poses(const model::AntennaModel& model, const AntennaScene& s,

@@ -17,9 +17,10 @@
 //                                                         │
 //                      selection: the best shape, its rivals, front and back (pose_selection.hpp)
 //
-// A candidate must fit the user's rectangle: its box, projected into the rectangle's photo, covers
-// at least `min_roi_fill` of it and has its centre inside it (the rectangle was drawn around this
-// antenna, so a pose on a neighbour or the mast does not qualify); its box must not pass through a
+// A candidate must fit the user's rectangle: its box, projected into the rectangle's photo, spans
+// at least `min_roi_span` of the rectangle's larger side and has its centre inside it (the
+// rectangle was drawn around this antenna, so a pose on a neighbour or the mast does not
+// qualify); its box must not pass through a
 // known neighbour's (neighbour_clearance_m: two panels cannot share volume); and its outline must
 // meet the photos' edges at least faintly (max_faint_outline_score, min_outline_views). Among
 // those, only the comparison with the best (pose_selection.hpp) rules a candidate out: a fixed
@@ -99,7 +100,7 @@ struct RegisterOptions {
   FacePlaneOptions face_plane;                     // the result's faces checked against its points (face_plane.hpp)
   std::size_t shape_candidates = 3;                // that many, by their outline
   double same_pose_deg = 2.0, same_pose_m = 0.03;  // refined candidates this close are one
-  double min_roi_fill = 0.3;
+  double min_roi_span = 0.55;                      // outline_search.hpp's rectangle_fit
   /// A pose fits its outline clearly where SilhouetteResult::score is at most `max_outline_score`
   /// (half of the outline without an edge within the cutoff scores 0.5) in at least
   /// `min_outline_views` photos. A result beyond it may still be the antenna, its edges faint
@@ -167,10 +168,9 @@ RegisterOptions continuing(RegisterOptions options);
 AntennaRegistration register_antenna(const model::AntennaModel& model, const AntennaScene& scene,
                                      const RegisterOptions& options);
 
-/// Share of `roi` that the model's box at `T_board_antenna`, projected into `view`, covers (its
-/// projected corners' bounding box cut to the rectangle), and whether that box's centre lies in
-/// the rectangle. {0, false} where a corner is behind the camera.
-std::pair<double, bool> roi_fill(const Vec3& size_m, const Iso3& T_board_antenna, const SilhouetteView& view,
-                                 const camera::CameraIntrinsics& intrinsics, const cv::Rect& roi);
+/// How the model's box at `T_board_antenna`, projected into `view`, stands in `roi`
+/// (outline_search.hpp's rectangle_fit); {0, false} where a corner is behind the camera.
+RectangleFit roi_span(const Vec3& size_m, const Iso3& T_board_antenna, const SilhouetteView& view,
+                      const camera::CameraIntrinsics& intrinsics, const cv::Rect& roi);
 
 }  // namespace antpose::registration
