@@ -135,6 +135,10 @@ TEST(OutlineSearch, ChecksItsOptionsAndInputs) {
   OutlineSearchInput in = input_for(s, Vec3(0.3, 0.16, 1.31), s.T_board_antenna.translation());
   in.region_view = 99;
   EXPECT_THROW(search_box_outline(in, s.intrinsics, {}), std::invalid_argument);
+  in.region_view = 3;
+  in.roi = rectangle_around(s, 3, Vec3(0.3, 0.16, 1.31), 0.1);
+  in.min_roi_span = 0;  // would sweep the depth for ever
+  EXPECT_THROW(search_box_outline(in, s.intrinsics, {}), std::invalid_argument);
 }
 
 }  // namespace

@@ -319,6 +319,8 @@ void check_input(const OutlineSearchInput& input, const OutlineSearchOptions& op
   throw_unless_ok(options.Check(), "OutlineSearchOptions");
   if (input.views && input.region_view >= input.views->size())
     throw std::invalid_argument(std::string(caller) + ": the region view is out of range");
+  if (input.roi && !(input.min_roi_span > 0 && input.min_roi_span <= 1))
+    throw std::invalid_argument(std::string(caller) + ": min_roi_span must lie in (0, 1]");
 }
 
 }  // namespace
