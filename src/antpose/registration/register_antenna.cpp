@@ -159,17 +159,30 @@ bool passes_through_neighbour(const OrientedBox& box, const std::vector<Oriented
          });
 }
 
+// The best outline among the refined candidates centred in the rectangle but spanning too little
+// of it (distinct_in_rectangle), and its span: where it fits clearly and nothing that spans the
+// rectangle does, the rectangle is drawn too loosely, not the photos unclear.
+struct TooSmallInRectangle {
+  double score = 1.0, span = 0.0;
+  void note(double outline_score, double rectangle_span) {
+    if (outline_score < score) score = outline_score, span = rectangle_span;
+  }
+};
+
 // Refined candidates that fit the rectangle and pass through no known neighbour, one per place: of
 // those ending at the same box pose, the one whose outline fits best, or the best with a profiled
 // shape where one has it (the shape is the panel's; a descent with the model's guessed one is no
 // better evidence of the pose). Best outline first.
 std::vector<Refined> distinct_in_rectangle(std::vector<Refined> refined, const model::AntennaModel& model,
-                                           const AntennaScene& s, const RegisterOptions& o) {
+                                           const AntennaScene& s, const RegisterOptions& o,
+                                           TooSmallInRectangle& too_small) {
   std::sort(refined.begin(), refined.end(), fits_better);
   std::vector<Refined> out;
   for (auto& r : refined) {
     const Iso3& T = r.candidate.T_board_antenna;
     const auto fit = roi_span(model.size_m, T, s.views[s.region_view], s.intrinsics, s.roi);
+    if (fit.centred && fit.span < o.min_roi_span && r.outline.views_used >= o.min_outline_views)
+      too_small.note(r.outline.score, fit.span);
     if (fit.span < o.min_roi_span || !fit.centred) continue;
     if (passes_through_neighbour({T, model.size_m}, s.neighbours_board, o.neighbour_clearance_m)) continue;
     const auto known = std::find_if(out.begin(), out.end(), [&](const Refined& k) {
@@ -256,8 +269,9 @@ std::vector<PoseCandidate> slid_proposals(const std::vector<Refined>& kept, cons
 // The proposals refined (refine_all), distinct in the rectangle, and the best turned about its
 // long axis (turned_proposals, placed_turns) or slid along it (slid_proposals) and refined too.
 std::vector<Refined> refine_and_turn(const std::shared_ptr<const model::AntennaModel>& shared, const AntennaScene& s,
-                                     const std::vector<PoseCandidate>& proposals, const RegisterOptions& o) {
-  auto kept = distinct_in_rectangle(refine_all(shared, s, proposals, o), *shared, s, o);
+                                     const std::vector<PoseCandidate>& proposals, const RegisterOptions& o,
+                                     TooSmallInRectangle& too_small) {
+  auto kept = distinct_in_rectangle(refine_all(shared, s, proposals, o), *shared, s, o, too_small);
   auto turned = turned_proposals(kept, s, o);
   if (auto facing = facing_mast_proposal(kept, s, o)) turned.push_back(std::move(*facing));
   const auto placed = placed_turns(turned, kept, *shared, s, o);
@@ -275,7 +289,7 @@ std::vector<Refined> refine_and_turn(const std::shared_ptr<const model::AntennaM
   });
   kept.insert(kept.end(), std::make_move_iterator(more.begin()), std::make_move_iterator(more.end()));
   kept.insert(kept.end(), std::make_move_iterator(moved.begin()), std::make_move_iterator(moved.end()));
-  return distinct_in_rectangle(std::move(kept), *shared, s, o);
+  return distinct_in_rectangle(std::move(kept), *shared, s, o, too_small);
 }
 
 // The best candidates' shape (edge rounding, end caps) profiled with their poses (shape_fit.hpp),
@@ -328,7 +342,8 @@ void fit_shapes(std::vector<Refined>& kept, const AntennaScene& s, const Registe
 // The best candidate's crease twins (yaw_turns.hpp) with its model, placed by the outline at their
 // own turn (refine_all), where they fit the rectangle and no candidate stands yet; their own shape
 // is profiled next (fit_shapes).
-void add_crease_twins(std::vector<Refined>& kept, const AntennaScene& s, const RegisterOptions& o) {
+void add_crease_twins(std::vector<Refined>& kept, const AntennaScene& s, const RegisterOptions& o,
+                      TooSmallInRectangle& too_small) {
   if (!o.crease_twins || kept.empty()) return;
   const auto best_it = best_outline(kept);
   const auto with = best_it->model;
@@ -341,7 +356,7 @@ void add_crease_twins(std::vector<Refined>& kept, const AntennaScene& s, const R
     return stands_among(m.candidate.T_board_antenna, kept, o.same_pose_deg, o.same_pose_m);
   });
   kept.insert(kept.end(), std::make_move_iterator(placed.begin()), std::make_move_iterator(placed.end()));
-  kept = distinct_in_rectangle(std::move(kept), *with, s, o);
+  kept = distinct_in_rectangle(std::move(kept), *with, s, o, too_small);
 }
 
 // The candidates whose outline meets the photos' edges at least faintly (max_faint_outline_score,
@@ -560,10 +575,22 @@ AntennaRegistration register_antenna(const model::AntennaModel& model, const Ant
   throw_unless_ok(o.Check(), "RegisterOptions");
   check_scene(s);
   const auto shared = std::make_shared<const model::AntennaModel>(model);
-  auto kept = refine_and_turn(shared, s, proposals, o);
-  add_crease_twins(kept, s, o);
+  TooSmallInRectangle too_small;
+  auto kept = refine_and_turn(shared, s, proposals, o, too_small);
+  add_crease_twins(kept, s, o, too_small);
   fit_shapes(kept, s, o);
   keep_fitting_outlines(kept, s, o);
+  const auto best = best_outline(kept);
+  if ((best == kept.end() || best->outline.score > o.max_outline_score) && too_small.score <= o.max_outline_score) {
+    AntennaRegistration none;
+    none.proposed = proposals.size();
+    none.why_not = fmt::format(
+        "a pose of the model '{}' fits its outline clearly (score {:.2f}) but spans only {:.0f} % of the "
+        "rectangle's longer side (a rectangle drawn around it: at least {:.0f} %), and no pose that spans it fits "
+        "more than faintly: is the rectangle drawn closely around the whole antenna?",
+        model.name, too_small.score, 100 * too_small.span, 100 * o.min_roi_span);
+    return none;
+  }
   if (kept.empty()) {
     AntennaRegistration none;
     none.proposed = proposals.size();
@@ -574,7 +601,7 @@ AntennaRegistration register_antenna(const model::AntennaModel& model, const Ant
                   "drawn around the antenna, and is the model this antenna's?",
                   model.name)
             : fmt::format(
-                  "no pose of the model '{}' fits its outline in the photos and fills the rectangle ({} "
+                  "no pose of the model '{}' fits its outline in the photos and spans the rectangle ({} "
                   "tried): is the rectangle drawn closely around the whole antenna, and is the model this "
                   "antenna's?",
                   model.name, proposals.size());
