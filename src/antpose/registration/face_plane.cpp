@@ -45,7 +45,7 @@ struct PlaneFit {
   double variance = 0.0;
   double span_u = 0.0, span_v = 0.0;
   std::size_t n = 0;
-  std::size_t cells = 0;  // correlation_m squares the points occupy
+  std::size_t cells = 0;  // cell_m squares the points occupy
 };
 
 std::optional<PlaneFit> least_squares(const std::vector<Vec3>& uvd, double cell_m) {

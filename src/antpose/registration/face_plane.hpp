@@ -22,8 +22,9 @@
 // points' correlation: n_eff counts the correlation_m squares of the face the points occupy (the
 // dense matching's window spreads one error over its neighbours, and points bunched on a plain
 // radome's few details are few measurements however many they are), plus the face's own deviation
-// from a plane (`flatness_m`) over its extent. The disagreement is χ² = sᵀ(C_s + H Σ Hᵀ)⁻¹s of the slopes s
-// against the outline's rotation covariance Σ carried into slope space (H: ω to the slopes).
+// from a plane (`flatness_m`) over its extent. The disagreement is χ² = sᵀ(C_s + H Σ Hᵀ)⁻¹s of the
+// slopes s against the outline's rotation covariance Σ carried into slope space (H: ω to the
+// slopes).
 #pragma once
 
 #include <cstddef>

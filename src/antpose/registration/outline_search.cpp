@@ -247,22 +247,16 @@ double BoxOutlineCost::view_cost(std::size_t v, const std::array<Vec3, 8>& corne
   return measured ? sum / static_cast<double>(measured) : 1.0;
 }
 
-bool BoxOutlineCost::fits_rectangle(const std::array<Vec3, 8>& corners_board) const {
+bool BoxOutlineCost::fits_rectangle(const Iso3& T_board_antenna) const {
   if (!input_.roi) return true;
-  const auto& view = (*input_.views)[input_.region_view];
-  Eigen::AlignedBox2d box;
-  for (const Vec3& c : corners_board) {
-    const auto uv = intrinsics_.project(view.R_camera_board * c + view.t_camera_board);
-    if (!uv) return false;
-    box.extend(*uv);
-  }
-  const auto fit = rectangle_fit(box, *input_.roi);
+  const auto fit =
+      roi_span(input_.box_size_m, T_board_antenna, (*input_.views)[input_.region_view], intrinsics_, *input_.roi);
   return fit.centred && fit.span >= input_.min_roi_span;
 }
 
 std::pair<double, std::size_t> BoxOutlineCost::operator()(const Iso3& T_board_antenna) const {
+  if (!fits_rectangle(T_board_antenna)) return {1.0, 0};
   const auto c = corners(input_.box_size_m, T_board_antenna.linear(), T_board_antenna.translation());
-  if (!fits_rectangle(c)) return {1.0, 0};
   double sum = 0.0;
   std::size_t views = 0;
   for (std::size_t v = 0; v < maps_.size(); ++v) {
@@ -332,6 +326,17 @@ RectangleFit rectangle_fit(const Eigen::AlignedBox2d& projected_px, const cv::Re
   if (cut.isEmpty()) return {0.0, false};
   const int along = roi.width >= roi.height ? 0 : 1;
   return {cut.sizes()[along] / rect.sizes()[along], rect.contains(projected_px.center())};
+}
+
+RectangleFit roi_span(const Vec3& size_m, const Iso3& T_board_antenna, const SilhouetteView& view,
+                      const camera::CameraIntrinsics& K, const cv::Rect& roi) {
+  Eigen::AlignedBox2d box;
+  for (const Vec3& c : corners(size_m, T_board_antenna.linear(), T_board_antenna.translation())) {
+    const auto uv = K.project(view.R_camera_board * c + view.t_camera_board);
+    if (!uv) return {};
+    box.extend(*uv);
+  }
+  return rectangle_fit(box, roi);
 }
 
 OutlineSearchResult search_box_outline(const OutlineSearchInput& input, const camera::CameraIntrinsics& intrinsics,

@@ -80,6 +80,11 @@ struct RectangleFit {
 };
 RectangleFit rectangle_fit(const Eigen::AlignedBox2d& projected_px, const cv::Rect& roi);
 
+/// rectangle_fit of the box of `size_m` (width, depth, height) at `T_board_antenna`, projected into
+/// `view`; {0, false} where a corner is behind the camera.
+RectangleFit roi_span(const Vec3& size_m, const Iso3& T_board_antenna, const SilhouetteView& view,
+                      const camera::CameraIntrinsics& intrinsics, const cv::Rect& roi);
+
 struct OutlineCandidate {
   Iso3 T_board_antenna = Iso3::Identity();  // the box's pose (which way round is not decided)
   double cost = 1.0;                        // 0 (every sample on an edge) .. 1
@@ -115,7 +120,7 @@ class BoxOutlineCost {
 
  private:
   double view_cost(std::size_t v, const std::array<Vec3, 8>& corners_board, bool& counted) const;
-  bool fits_rectangle(const std::array<Vec3, 8>& corners_board) const;
+  bool fits_rectangle(const Iso3& T_board_antenna) const;
   const OutlineSearchInput& input_;
   const camera::CameraIntrinsics& intrinsics_;
   const OutlineSearchOptions& options_;

@@ -492,6 +492,14 @@ void check_faces(AntennaRegistration& out, const model::AntennaModel& model, con
   }
 }
 
+// "Not found", and why.
+AntennaRegistration not_found(std::size_t proposed, std::string why) {
+  AntennaRegistration none;
+  none.proposed = proposed;
+  none.why_not = std::move(why);
+  return none;
+}
+
 void check_scene(const AntennaScene& s) {
   if (s.views.empty() || s.region_view >= s.views.size() || s.areas.size() != s.views.size() ||
       s.viewpoints_board.size() != s.views.size())
@@ -533,17 +541,6 @@ OptionProblems RegisterOptions::Check() const {
   return p;
 }
 
-RectangleFit roi_span(const Vec3& size_m, const Iso3& T_board_antenna, const SilhouetteView& view,
-                      const camera::CameraIntrinsics& K, const cv::Rect& roi) {
-  Eigen::AlignedBox2d box;
-  for (const Vec3& corner : model::box_corners(size_m)) {
-    const auto uv = K.project(view.R_camera_board * (T_board_antenna * corner) + view.t_camera_board);
-    if (!uv) return {};
-    box.extend(*uv);
-  }
-  return rectangle_fit(box, roi);
-}
-
 std::vector<PoseCandidate> propose_poses(const model::AntennaModel& model, const AntennaScene& s,
                                          const RegisterOptions& o) {
   throw_unless_ok(o.Check(), "RegisterOptions");
@@ -582,30 +579,24 @@ AntennaRegistration register_antenna(const model::AntennaModel& model, const Ant
   keep_fitting_outlines(kept, s, o);
   const auto best = best_outline(kept);
   if ((best == kept.end() || best->outline.score > o.max_outline_score) && too_small.score <= o.max_outline_score) {
-    AntennaRegistration none;
-    none.proposed = proposals.size();
-    none.why_not = fmt::format(
-        "a pose of the model '{}' fits its outline clearly (score {:.2f}) but spans only {:.0f} % of the "
-        "rectangle's longer side (a rectangle drawn around it: at least {:.0f} %), and no pose that spans it fits "
-        "more than faintly: is the rectangle drawn closely around the whole antenna?",
-        model.name, too_small.score, 100 * too_small.span, 100 * o.min_roi_span);
-    return none;
+    return not_found(
+        proposals.size(),
+        fmt::format("a pose of the model '{}' fits its outline clearly (score {:.2f}) but spans only {:.0f} % of the "
+                    "rectangle's longer side (a rectangle drawn around it: at least {:.0f} %), and no pose that spans "
+                    "it fits more than faintly: is the rectangle drawn closely around the whole antenna?",
+                    model.name, too_small.score, 100 * too_small.span, 100 * o.min_roi_span));
   }
   if (kept.empty()) {
-    AntennaRegistration none;
-    none.proposed = proposals.size();
-    none.why_not =
+    return not_found(
+        proposals.size(),
         proposals.empty()
-            ? fmt::format(
-                  "nothing in the rectangle fits the outline of the model '{}' in the photos: is the rectangle "
-                  "drawn around the antenna, and is the model this antenna's?",
-                  model.name)
-            : fmt::format(
-                  "no pose of the model '{}' fits its outline in the photos and spans the rectangle ({} "
-                  "tried): is the rectangle drawn closely around the whole antenna, and is the model this "
-                  "antenna's?",
-                  model.name, proposals.size());
-    return none;
+            ? fmt::format("nothing in the rectangle fits the outline of the model '{}' in the photos: is the rectangle "
+                          "drawn around the antenna, and is the model this antenna's?",
+                          model.name)
+            : fmt::format("no pose of the model '{}' fits its outline in the photos and spans the rectangle ({} "
+                          "tried): is the rectangle drawn closely around the whole antenna, and is the model this "
+                          "antenna's?",
+                          model.name, proposals.size()));
   }
   auto out = select(s, std::move(kept), o);
   out.proposed = proposals.size();

@@ -20,13 +20,15 @@
 // A candidate must fit the user's rectangle: its box, projected into the rectangle's photo, spans
 // at least `min_roi_span` of the rectangle's larger side and has its centre inside it (the
 // rectangle was drawn around this antenna, so a pose on a neighbour or the mast does not
-// qualify); its box must not pass through a
-// known neighbour's (neighbour_clearance_m: two panels cannot share volume); and its outline must
-// meet the photos' edges at least faintly (max_faint_outline_score, min_outline_views). Among
+// qualify); its box must not pass through a known neighbour's (neighbour_clearance_m: two panels
+// cannot share volume); and its outline must meet the photos' edges at least faintly
+// (max_faint_outline_score, min_outline_views). Among
 // those, only the comparison with the best (pose_selection.hpp) rules a candidate out: a fixed
 // score cut would drop the true pose wherever the edges are faint or cluttered and a wrong pose
-// meets other edges a little better, leaving that wrong pose unique. "Not found" is a value: the
-// result says why and what photo or rectangle would help.
+// meets other edges a little better, leaving that wrong pose unique. The result's faces are then
+// checked against the region's points (face_plane.hpp). "Not found" is a value: the result says
+// why and what photo or rectangle would help, and a pose that fits clearly but spans too little of
+// a rectangle in which nothing else fits more than faintly says the rectangle is drawn too loosely.
 #pragma once
 
 #include <cstddef>
@@ -167,10 +169,5 @@ RegisterOptions continuing(RegisterOptions options);
 /// propose_poses, then the above.
 AntennaRegistration register_antenna(const model::AntennaModel& model, const AntennaScene& scene,
                                      const RegisterOptions& options);
-
-/// How the model's box at `T_board_antenna`, projected into `view`, stands in `roi`
-/// (outline_search.hpp's rectangle_fit); {0, false} where a corner is behind the camera.
-RectangleFit roi_span(const Vec3& size_m, const Iso3& T_board_antenna, const SilhouetteView& view,
-                      const camera::CameraIntrinsics& intrinsics, const cv::Rect& roi);
 
 }  // namespace antpose::registration
