@@ -6,6 +6,7 @@
 
 #include "antpose/camera/board_pose.hpp"
 #include "antpose/model/box_file.hpp"
+#include "antpose/registration/known_object_masks.hpp"
 
 namespace antpose::measure {
 
@@ -134,6 +135,7 @@ registration::AntennaScene registration_scene(const CameraPoses& poses, const Ve
     registration::SilhouetteView& v = s.views.emplace_back();
     v.image = pv.image, v.R_camera_board = pv.R_camera_board, v.t_camera_board = pv.t_camera_board;
     if (i < poses.edges.size()) v.edges = poses.edges[i];
+    v.masks = std::make_shared<registration::KnownObjectMasks>();
     add_known(v, board_outline(objects.board_box, s.intrinsics, v.R_camera_board, v.t_camera_board), true);
     if (objects.mast) add_mast(v, *objects.mast, s.intrinsics, camera, centre);
     for (const auto& b : objects.neighbours)

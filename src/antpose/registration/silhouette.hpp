@@ -75,6 +75,8 @@
 
 namespace antpose::registration {
 
+class KnownObjectMasks;  // known_object_masks.hpp
+
 struct SilhouetteView {
   cv::Mat image;  // CV_8UC1 grey photo as taken (distorted), full size
   Mat3 R_camera_board = Mat3::Identity();
@@ -95,6 +97,9 @@ struct SilhouetteView {
   /// crop is prepared once; nullptr (or one made with another gamma or smoothing): each
   /// refinement prepares its own.
   std::shared_ptr<EdgePyramid> edges;
+  /// The known objects' masks drawn once for every refinement in this photo with these objects
+  /// (known_object_masks.hpp); nullptr: each refinement draws its own. Used with `edges`.
+  std::shared_ptr<KnownObjectMasks> masks;
 };
 
 struct SilhouetteOptions {

@@ -26,6 +26,13 @@ struct EdgeMesh {
   };
   std::vector<Edge> edges;
   bool closed = false;  // every edge between two triangles or more: the mesh bounds a solid
+  /// The triangles as convex planar polygons (coplanar neighbours merged), which cover the
+  /// projection with few fills; every triangle lies in one.
+  struct Facet {
+    std::vector<std::uint32_t> loop;  // boundary vertices, wound as its triangles
+    std::uint32_t triangle = 0;       // one of them (all face the same way)
+  };
+  std::vector<Facet> facets;
 };
 
 EdgeMesh weld(const model::Mesh& mesh);

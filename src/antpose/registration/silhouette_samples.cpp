@@ -2,9 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <map>
 #include <stdexcept>
-#include <tuple>
 
 #include <fmt/format.h>
 #include <opencv2/core/utility.hpp>
@@ -12,37 +10,9 @@
 
 #include "antpose/camera/edge_search.hpp"
 #include "antpose/core/rounding.hpp"
+#include "antpose/registration/known_object_masks.hpp"
 
 namespace antpose::registration::detail {
-
-EdgeMesh weld(const model::Mesh& mesh) {
-  EdgeMesh m;
-  std::map<std::tuple<long long, long long, long long>, std::uint32_t> index;
-  std::vector<std::uint32_t> remap(mesh.vertices.size());
-  for (std::size_t i = 0; i < mesh.vertices.size(); ++i) {
-    const Vec3& v = mesh.vertices[i];
-    const auto key = std::make_tuple(std::llround(v.x() * 1e7), std::llround(v.y() * 1e7), std::llround(v.z() * 1e7));
-    const auto [it, inserted] = index.emplace(key, static_cast<std::uint32_t>(m.vertices.size()));
-    if (inserted) m.vertices.push_back(v);
-    remap[i] = it->second;
-  }
-  std::map<std::pair<std::uint32_t, std::uint32_t>, std::size_t> edge_index;
-  for (const auto& t : mesh.triangles) {
-    const std::array<std::uint32_t, 3> w{remap.at(t[0]), remap.at(t[1]), remap.at(t[2])};
-    if (w[0] == w[1] || w[1] == w[2] || w[0] == w[2]) continue;
-    const auto f = static_cast<std::uint32_t>(m.triangles.size());
-    m.triangles.push_back(w);
-    m.normals.push_back((m.vertices[w[1]] - m.vertices[w[0]]).cross(m.vertices[w[2]] - m.vertices[w[0]]));
-    for (int k = 0; k < 3; ++k) {
-      const auto key = std::minmax(w[k], w[(k + 1) % 3]);
-      const auto [it, inserted] = edge_index.emplace(key, m.edges.size());
-      if (inserted) m.edges.push_back({key.first, key.second, {}});
-      m.edges[it->second].faces.push_back(f);
-    }
-  }
-  m.closed = std::all_of(m.edges.begin(), m.edges.end(), [](const EdgeMesh::Edge& e) { return e.faces.size() >= 2; });
-  return m;
-}
 
 namespace {
 
@@ -53,29 +23,6 @@ bool masked(const PreparedView& v, int level, const Vec2& p) {
   const int x = round_half_away(q.x()), y = round_half_away(q.y());
   const cv::Mat& m = v.mask[static_cast<std::size_t>(level)];
   return x >= 0 && y >= 0 && x < m.cols && y < m.rows && m.at<std::uint8_t>(y, x) != 0;
-}
-
-// The view's mask at one level: the occluders filled, the background edges drawn, both widened
-// by `guard_px` (the level's px) so that their blurred edges cannot be taken for the antenna's.
-cv::Mat level_mask(const SilhouetteView& in, const Vec2& offset, cv::Size size, int level, double guard_px) {
-  cv::Mat m = cv::Mat::zeros(size, CV_8UC1);
-  const double s = std::ldexp(1.0, -level);
-  constexpr int kShift = 2;  // quarter-pixel vertices
-  const auto to_level = [&](const std::vector<cv::Point2f>& poly) {
-    std::vector<cv::Point> out;
-    for (const auto& p : poly)
-      out.emplace_back(static_cast<int>(std::lround((p.x - offset.x()) * s * (1 << kShift))),
-                       static_cast<int>(std::lround((p.y - offset.y()) * s * (1 << kShift))));
-    return out;
-  };
-  for (const auto& poly : in.occluders)
-    if (poly.size() >= 3) cv::fillPoly(m, std::vector<std::vector<cv::Point>>{to_level(poly)}, 255, cv::LINE_8, kShift);
-  for (const auto& line : in.background_edges)
-    if (line.size() >= 2)
-      cv::polylines(m, std::vector<std::vector<cv::Point>>{to_level(line)}, false, 255, 1, cv::LINE_8, kShift);
-  const int r = static_cast<int>(std::ceil(guard_px));
-  cv::dilate(m, m, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * r + 1, 2 * r + 1)));
-  return m;
 }
 
 std::optional<Vec2> project(const camera::CameraIntrinsics& K, const PreparedView& v, const Vec3& p_board) {
@@ -142,13 +89,14 @@ std::optional<ProjectionMask> project_model(const EdgeMesh& m, const Pose& pose,
   out.mask = cv::Mat::zeros(static_cast<int>(std::ceil(extent.y() / out.ms)) + 1,
                             static_cast<int>(std::ceil(extent.x() / out.ms)) + 1, CV_8UC1);
   std::vector<cv::Point> poly;
-  for (std::size_t f = 0; f < m.triangles.size(); ++f) {
-    if (m.closed && !front[f]) continue;
-    const auto& t = m.triangles[f];
+  for (const auto& facet : m.facets) {
+    if (m.closed && !front[facet.triangle]) continue;
+    const auto& t = facet.loop;
+    const std::size_t corners = t.size();
     poly.clear();
-    for (int k = 0; k < 3; ++k) {
-      const Vec3 A = pose.R * m.vertices[t[k]] + pose.t, B = pose.R * m.vertices[t[(k + 1) % 3]] + pose.t;
-      const Vec2 &a = *out.uv[t[k]], &b = *out.uv[t[(k + 1) % 3]];
+    for (std::size_t k = 0; k < corners; ++k) {
+      const Vec3 A = pose.R * m.vertices[t[k]] + pose.t, B = pose.R * m.vertices[t[(k + 1) % corners]] + pose.t;
+      const Vec2 &a = *out.uv[t[k]], &b = *out.uv[t[(k + 1) % corners]];
       const double len = (b - a).norm() / out.ms;
       // Subdivided where the distortion bows the side by more than the vertices' quarter pixel.
       const auto middle = project(K, v, 0.5 * (A + B));
@@ -162,7 +110,7 @@ std::optional<ProjectionMask> project_model(const EdgeMesh& m, const Pose& pose,
         poly.emplace_back(round_half_away(q.x()), round_half_away(q.y()));
       }
     }
-    // A triangle's projection, its sides bowed by the distortion alone, is monotonic in y.
+    // A convex facet's projection, its sides bowed by the distortion alone, is monotonic in y.
     cv::fillConvexPoly(out.mask, poly, cv::Scalar(255), cv::LINE_8, 2);
   }
   return out;
@@ -369,12 +317,18 @@ PreparedViews prepare_views(const EdgeMesh& m, const std::vector<Pose>& poses, c
       v.offset = Vec2(levels.crop.x, levels.crop.y);
       v.size = levels.crop.size();
       const bool with_mask = !in.occluders.empty() || !in.background_edges.empty();
+      const bool kept_masks = with_mask && in.masks && in.edges && in.edges->serves(gamma, sigma);
       for (int l = 0; l <= out.top; ++l) {
         cv::Mat gx = levels.gx[static_cast<std::size_t>(l)], gy = levels.gy[static_cast<std::size_t>(l)];
-        if (with_mask) {
+        if (kept_masks) {
+          auto masked = in.masks->masked(in, gx, gy, v.offset, l, options.mask_guard_px);
+          v.mask.push_back(masked.mask);
+          gx = masked.gx, gy = masked.gy;
+        } else if (with_mask) {
           // The shared images stay as they are: this view's known objects are its own. Where none
           // reaches the crop, the shared images serve unchanged (no copy).
-          const cv::Mat& mask = v.mask.emplace_back(level_mask(in, v.offset, gx.size(), l, options.mask_guard_px));
+          const cv::Mat& mask =
+              v.mask.emplace_back(known_object_mask(in, v.offset, gx.size(), l, options.mask_guard_px));
           if (cv::countNonZero(mask) > 0) {
             gx = gx.clone(), gy = gy.clone();
             gx.setTo(0, mask);
