@@ -47,6 +47,16 @@ cv::Mat known_object_mask(const SilhouetteView& in, const Vec2& origin, cv::Size
   return m;
 }
 
+MaskedEdges masked_edges(cv::Mat mask, const cv::Mat& gx, const cv::Mat& gy) {
+  MaskedEdges out{std::move(mask), gx, gy};
+  if (cv::countNonZero(out.mask) > 0) {
+    out.gx = gx.clone(), out.gy = gy.clone();
+    out.gx.setTo(0, out.mask);
+    out.gy.setTo(0, out.mask);
+  }
+  return out;
+}
+
 MaskedEdges KnownObjectMasks::masked(const SilhouetteView& view, const cv::Mat& gx, const cv::Mat& gy,
                                      const Vec2& origin, int level, double guard_px) {
   cv::Size whole_size;
@@ -64,15 +74,10 @@ MaskedEdges KnownObjectMasks::masked(const SilhouetteView& view, const cv::Mat& 
     cv::Mat whole_gx = gx, whole_gy = gy;
     whole_gx.adjustROI(at.y, whole_size.height - at.y - gx.rows, at.x, whole_size.width - at.x - gx.cols);
     whole_gy.adjustROI(at.y, whole_size.height - at.y - gy.rows, at.x, whole_size.width - at.x - gy.cols);
-    Kept k{gx.datastart, level, guard_px, objects, {}, whole_gx, 0};
     const Vec2 whole_origin = origin - std::ldexp(1.0, level) * Vec2(at.x, at.y);
-    k.whole.mask = known_object_mask(view, whole_origin, whole_size, level, guard_px);
-    k.whole.gx = whole_gx, k.whole.gy = whole_gy;
-    if (cv::countNonZero(k.whole.mask) > 0) {  // else the images serve unchanged (no copy)
-      k.whole.gx = whole_gx.clone(), k.whole.gy = whole_gy.clone();
-      k.whole.gx.setTo(0, k.whole.mask);
-      k.whole.gy.setTo(0, k.whole.mask);
-    }
+    Kept k;
+    k.crop = gx.datastart, k.level = level, k.guard_px = guard_px, k.objects = objects, k.source_gx = whole_gx;
+    k.whole = masked_edges(known_object_mask(view, whole_origin, whole_size, level, guard_px), whole_gx, whole_gy);
     if (kept_.size() >= kKept)
       kept_.erase(std::min_element(kept_.begin(), kept_.end(),
                                    [](const Kept& a, const Kept& b) { return a.last_use < b.last_use; }));

@@ -32,6 +32,9 @@ struct MaskedEdges {
   cv::Mat gx, gy;  // the edge images, 0 under the mask (the images given where it is empty)
 };
 
+/// `gx`, `gy` zeroed under `mask`: copies, or the images themselves where the mask is empty.
+MaskedEdges masked_edges(cv::Mat mask, const cv::Mat& gx, const cv::Mat& gy);
+
 class KnownObjectMasks {
  public:
   /// `gx`, `gy`: level `level` of `view`'s edge images, sub-images of a crop the edge pyramid

@@ -320,20 +320,13 @@ PreparedViews prepare_views(const EdgeMesh& m, const std::vector<Pose>& poses, c
       const bool kept_masks = with_mask && in.masks && in.edges && in.edges->serves(gamma, sigma);
       for (int l = 0; l <= out.top; ++l) {
         cv::Mat gx = levels.gx[static_cast<std::size_t>(l)], gy = levels.gy[static_cast<std::size_t>(l)];
-        if (kept_masks) {
-          auto masked = in.masks->masked(in, gx, gy, v.offset, l, options.mask_guard_px);
+        if (with_mask) {
+          // The shared images stay as they are: this view's known objects are its own.
+          const double guard = options.mask_guard_px;
+          const auto masked = kept_masks ? in.masks->masked(in, gx, gy, v.offset, l, guard)
+                                         : masked_edges(known_object_mask(in, v.offset, gx.size(), l, guard), gx, gy);
           v.mask.push_back(masked.mask);
           gx = masked.gx, gy = masked.gy;
-        } else if (with_mask) {
-          // The shared images stay as they are: this view's known objects are its own. Where none
-          // reaches the crop, the shared images serve unchanged (no copy).
-          const cv::Mat& mask =
-              v.mask.emplace_back(known_object_mask(in, v.offset, gx.size(), l, options.mask_guard_px));
-          if (cv::countNonZero(mask) > 0) {
-            gx = gx.clone(), gy = gy.clone();
-            gx.setTo(0, mask);
-            gy.setTo(0, mask);
-          }
         }
         v.gx.push_back(gx);
         v.gy.push_back(gy);
