@@ -67,8 +67,7 @@ MaskedEdges KnownObjectMasks::masked(const SilhouetteView& view, const cv::Mat& 
   const std::lock_guard lock(mutex_);
   ++uses_;
   auto hit = std::find_if(kept_.begin(), kept_.end(), [&](const Kept& k) {
-    return k.crop == gx.datastart && k.level == level && k.guard_px == guard_px && k.objects == objects &&
-           k.whole.mask.size() == whole_size;
+    return k.crop == gx.datastart && k.level == level && k.guard_px == guard_px && k.objects == objects;
   });
   if (hit == kept_.end()) {
     cv::Mat whole_gx = gx, whole_gy = gy;

@@ -47,7 +47,7 @@ class KnownObjectMasks {
 
  private:
   struct Kept {
-    const void* crop = nullptr;  // the kept crop's gx data, held alive by `whole`
+    const void* crop = nullptr;  // the kept crop's gx data, held alive by `source_gx`
     int level = 0;
     double guard_px = 0;
     std::size_t objects = 0;  // hash of the view's known objects
