@@ -19,8 +19,9 @@ if [[ $# -lt 4 || $# -gt 5 ]]; then
 fi
 a=$1 b=$2 capture=$3 device=$4 rounds=${5:-3}
 for exe in "$a" "$b"; do
-  [[ -x $exe ]] || { echo "$0: '$exe' is not an executable antpose" >&2; exit 2; }
+  [[ -f $exe && -x $exe ]] || { echo "$0: '$exe' is not an executable antpose" >&2; exit 2; }
 done
+a=$(realpath "$a") b=$(realpath "$b")  # taskset would look a bare name up in PATH
 [[ -d $capture ]] || { echo "$0: '$capture' is not a capture folder" >&2; exit 2; }
 [[ -f $device ]] || { echo "$0: '$device' is not a device profile" >&2; exit 2; }
 [[ $(nproc) -ge 2 ]] || { echo "$0: needs two cores" >&2; exit 2; }

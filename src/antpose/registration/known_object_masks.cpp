@@ -67,15 +67,16 @@ MaskedEdges KnownObjectMasks::masked(const SilhouetteView& view, const cv::Mat& 
   const std::lock_guard lock(mutex_);
   ++uses_;
   auto hit = std::find_if(kept_.begin(), kept_.end(), [&](const Kept& k) {
-    return k.crop == gx.datastart && k.level == level && k.guard_px == guard_px && k.objects == objects;
+    return k.source_gx.datastart == gx.datastart && k.level == level && k.guard_px == guard_px && k.objects == objects;
   });
   if (hit == kept_.end()) {
-    cv::Mat whole_gx = gx, whole_gy = gy;
-    whole_gx.adjustROI(at.y, whole_size.height - at.y - gx.rows, at.x, whole_size.width - at.x - gx.cols);
-    whole_gy.adjustROI(at.y, whole_size.height - at.y - gy.rows, at.x, whole_size.width - at.x - gy.cols);
+    const auto whole = [&](cv::Mat m) {
+      return m.adjustROI(at.y, whole_size.height - at.y - m.rows, at.x, whole_size.width - at.x - m.cols);
+    };
+    const cv::Mat whole_gx = whole(gx), whole_gy = whole(gy);
     const Vec2 whole_origin = origin - std::ldexp(1.0, level) * Vec2(at.x, at.y);
     Kept k;
-    k.crop = gx.datastart, k.level = level, k.guard_px = guard_px, k.objects = objects, k.source_gx = whole_gx;
+    k.level = level, k.guard_px = guard_px, k.objects = objects, k.source_gx = whole_gx;
     k.whole = masked_edges(known_object_mask(view, whole_origin, whole_size, level, guard_px), whole_gx, whole_gy);
     if (kept_.size() >= kKept)
       kept_.erase(std::min_element(kept_.begin(), kept_.end(),

@@ -47,12 +47,11 @@ class KnownObjectMasks {
 
  private:
   struct Kept {
-    const void* crop = nullptr;  // the kept crop's gx data, held alive by `source_gx`
     int level = 0;
     double guard_px = 0;
     std::size_t objects = 0;  // hash of the view's known objects
     MaskedEdges whole;
-    cv::Mat source_gx;  // holds the kept crop, so that its address is not reused
+    cv::Mat source_gx;  // the kept crop's gx, whose data identifies it (held, so its address is not reused)
     std::size_t last_use = 0;
   };
 
