@@ -39,6 +39,32 @@ TEST(EdgeDistance, FindsAFaintOutlineAboveTheNoiseWhateverTheLight) {
   EXPECT_LT(cv::countNonZero(plain.edges()), 10);
 }
 
+TEST(EdgeDistance, AnOutlineMeetsEdgesOfItsOwnDirectionOrTheNextOnly) {
+  // A dark parallelogram whose left side's gradient runs at 15° (mod 180°), the middle of the
+  // first of six 30° bins; its other sides run along x, far from the point looked up.
+  cv::Mat image(400, 400, CV_8UC1, cv::Scalar(230));
+  const std::vector<cv::Point> shape{{189, 55}, {289, 55}, {211, 345}, {111, 345}};
+  cv::fillConvexPoly(image, shape, cv::Scalar(200), cv::LINE_AA);
+  const EdgeDistance map(image, cv::Rect(0, 0, image.cols, image.rows), 0.5, {}, {});
+  // 6 px (3 map px) from the left side, along its normal.
+  const double a = deg2rad(15.0);
+  const Vec2 p = Vec2(150.0, 200.0) - 6.0 * Vec2(std::cos(a), std::sin(a));
+  const auto at = [&](double degrees) {
+    EdgeLookup status;
+    const double b = deg2rad(degrees);
+    const double d = map.distance(p, map.bin(Vec2(std::cos(b), std::sin(b))), status);
+    EXPECT_EQ(status, EdgeLookup::kMeasured);
+    return d;
+  };
+  EXPECT_EQ(map.bin(Vec2(std::cos(a), std::sin(a))), 0);
+  EXPECT_NEAR(at(15.0), 3.0, 1.0);
+  // The next bins either side (1 and 5) take it too; bins 2 and 4 do not.
+  EXPECT_NEAR(at(50.0), 3.0, 1.0);
+  EXPECT_NEAR(at(-20.0), 3.0, 1.0);
+  EXPECT_GT(at(75.0), 20.0);
+  EXPECT_GT(at(-45.0), 20.0);
+}
+
 TEST(EdgeDistance, KnownOccludersAndTheOutsideSayTheirName) {
   const cv::Mat image = faint_panel(1.0, 4);
   const std::vector<std::vector<cv::Point2f>> board{{{90, 150}, {200, 150}, {200, 250}, {90, 250}}};

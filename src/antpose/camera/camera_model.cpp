@@ -47,6 +47,26 @@ std::optional<Vec2> CameraIntrinsics::project(const Vec3& p) const {
   return Vec2(fx * d.x() + cx, fy * d.y() + cy);
 }
 
+std::optional<Vec2> CameraIntrinsics::project(const Vec3& p, Eigen::Matrix<double, 2, 3>& d_uv_d_p) const {
+  if (!(p.z() > 0.0)) return std::nullopt;
+  const auto& [k1, k2, p1, p2, k3] = distortion;
+  const double x = p.x() / p.z(), y = p.y() / p.z();
+  const double r2 = x * x + y * y;
+  const double radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3));
+  const double d_radial_d_r2 = k1 + r2 * (2.0 * k2 + 3.0 * r2 * k3);
+  // d(x', y')/d(x, y) of the header's distortion, then d(x, y)/d(X, Y, Z) of the pinhole.
+  Eigen::Matrix2d d_distorted;
+  d_distorted << radial + 2.0 * x * x * d_radial_d_r2 + 2.0 * p1 * y + 6.0 * p2 * x,
+      2.0 * x * y * d_radial_d_r2 + 2.0 * p1 * x + 2.0 * p2 * y,
+      2.0 * x * y * d_radial_d_r2 + 2.0 * p1 * x + 2.0 * p2 * y,
+      radial + 2.0 * y * y * d_radial_d_r2 + 6.0 * p1 * y + 2.0 * p2 * x;
+  Eigen::Matrix<double, 2, 3> d_pinhole;
+  d_pinhole << 1.0 / p.z(), 0.0, -x / p.z(), 0.0, 1.0 / p.z(), -y / p.z();
+  d_uv_d_p = Eigen::DiagonalMatrix<double, 2>(fx, fy) * d_distorted * d_pinhole;
+  const Vec2 d = distort(Vec2(x, y));
+  return Vec2(fx * d.x() + cx, fy * d.y() + cy);
+}
+
 Vec3 CameraIntrinsics::ray(const Vec2& uv) const {
   const Vec2 xy = undistort(Vec2((uv.x() - cx) / fx, (uv.y() - cy) / fy));
   return Vec3(xy.x(), xy.y(), 1.0).normalized();

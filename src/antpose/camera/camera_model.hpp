@@ -29,6 +29,9 @@ struct CameraIntrinsics {
   bool has_distortion() const;
   /// Pixel of a camera-frame point (any Z > 0). std::nullopt behind the camera (Z ≤ 0).
   std::optional<Vec2> project(const Vec3& p_camera) const;
+  /// The same, with the pixel's derivative by the point, d(u, v)/d(X, Y, Z), in `d_uv_d_p`
+  /// (the chain of the pinhole's and the distortion's Jacobians; unchanged behind the camera).
+  std::optional<Vec2> project(const Vec3& p_camera, Eigen::Matrix<double, 2, 3>& d_uv_d_p) const;
   /// Normalised distorted coordinates (x', y') of the undistorted (x, y) = (X/Z, Y/Z).
   Vec2 distort(const Vec2& xy) const;
   /// Inverse of distort by fixed-point iteration (as cv::undistortPoints); accurate to 1e-10

@@ -57,7 +57,7 @@ class EdgeDistance {
   cv::Rect area_;
   double scale_ = 1.0, noise_grey_ = 0.0;
   cv::Mat edges_, mask_;
-  std::vector<cv::Mat> distance_;  // per bin, CV_32F
+  std::vector<cv::Mat> distance_;  // per bin, CV_32F: to the nearest edge of that bin or a bin either side
 };
 
 }  // namespace antpose::registration

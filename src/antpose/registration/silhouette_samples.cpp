@@ -31,6 +31,14 @@ std::optional<Vec2> project(const camera::CameraIntrinsics& K, const PreparedVie
   return K.project(c);
 }
 
+// The same, with d(pixel)/d(camera-frame point).
+std::optional<Vec2> project(const camera::CameraIntrinsics& K, const PreparedView& v, const Vec3& p_board,
+                            Eigen::Matrix<double, 2, 3>& d_uv_d_camera) {
+  const Vec3 c = v.R_cb * p_board + v.t_cb;
+  if (c.z() <= 1e-3) return std::nullopt;
+  return K.project(c, d_uv_d_camera);
+}
+
 // Bounding box (full-resolution px) of the projected vertices; nullopt when one is behind the camera.
 std::optional<cv::Rect2d> projected_box(const camera::CameraIntrinsics& K, const PreparedView& v, const EdgeMesh& m,
                                         const Pose& pose) {
@@ -116,24 +124,14 @@ std::optional<ProjectionMask> project_model(const EdgeMesh& m, const Pose& pose,
   return out;
 }
 
-// d(projection · normal)/d(δ, δt) of the point X (board frame) of the model at `pose`, by central
-// differences in the camera frame (distortion included).
-std::optional<Eigen::Matrix<double, 1, 6>> sample_jacobian(const camera::CameraIntrinsics& K, const PreparedView& v,
-                                                           const Pose& pose, const Vec3& X, const Vec2& normal) {
-  const Vec3 Xc = v.R_cb * X + v.t_cb;
-  Eigen::Matrix<double, 2, 3> dp;
-  const double h = 1e-6 * Xc.z();
-  for (int a = 0; a < 3; ++a) {
-    Vec3 dx = Vec3::Zero();
-    dx[a] = h;
-    const auto pp = K.project(Xc + dx), pm = K.project(Xc - dx);
-    if (!pp || !pm) return std::nullopt;
-    dp.col(a) = (*pp - *pm) / (2 * h);
-  }
+// d(projection · normal)/d(δ, δt) of the point X (board frame) of the model at `pose`, from the
+// projection's derivative by the camera-frame point (distortion included).
+Eigen::Matrix<double, 1, 6> sample_jacobian(const Eigen::Matrix<double, 2, 3>& d_uv_d_camera, const PreparedView& v,
+                                            const Pose& pose, const Vec3& X, const Vec2& normal) {
   Eigen::Matrix<double, 3, 6> dX;
   dX.leftCols<3>() = -skew(X - pose.t);
   dX.rightCols<3>() = Mat3::Identity();
-  return Eigen::Matrix<double, 1, 6>(normal.transpose() * dp * v.R_cb * dX);
+  return normal.transpose() * d_uv_d_camera * v.R_cb * dX;
 }
 
 // The outer contour samples of one view at `level` with their edge measurements; the
@@ -178,15 +176,14 @@ void gather(const EdgeMesh& m, const Pose& pose, const PreparedView& v, const ca
     const int n = static_cast<int>(std::floor((*pm.uv[e.b] - *pm.uv[e.a]).norm() / spacing));
     const Vec3 A = pose.R * a_antenna + pose.t, B = pose.R * b_antenna + pose.t;
     for (int j = 0; j < n; ++j) {
-      const double s = (j + 0.5) / n, ds = 0.25 / n;
+      const double s = (j + 0.5) / n;
       const bool attachment = !on_box(a_antenna + (b_antenna - a_antenna) * s);
       if (attachment && !what.attachments) continue;
       const Vec3 X = A + (B - A) * s;
-      const auto p = project(K, v, X);
-      const auto p0 = project(K, v, A + (B - A) * (s - ds));
-      const auto p1 = project(K, v, A + (B - A) * (s + ds));
-      if (!p || !p0 || !p1) continue;
-      const Vec2 d = (*p1 - *p0).normalized();
+      Eigen::Matrix<double, 2, 3> d_uv_d_camera;
+      const auto p = project(K, v, X, d_uv_d_camera);
+      if (!p) continue;
+      const Vec2 d = (d_uv_d_camera * (v.R_cb * (B - A))).normalized();  // the projected edge's tangent
       Vec2 normal(-d.y(), d.x());
       const Vec2 q = pm.to_mask(*p);
       const bool in_minus = pm.inside(q - 1.5 * normal), in_plus = pm.inside(q + 1.5 * normal);
@@ -224,12 +221,8 @@ void gather(const EdgeMesh& m, const Pose& pose, const PreparedView& v, const ca
         continue;
       }
       if (!edge) continue;
-      Eigen::Matrix<double, 1, 6> J = Eigen::Matrix<double, 1, 6>::Zero();
-      if (what.jacobians) {
-        const auto dp = sample_jacobian(K, v, pose, X, normal);
-        if (!dp) continue;
-        J = *dp;
-      }
+      const Eigen::Matrix<double, 1, 6> J =
+          what.jacobians ? sample_jacobian(d_uv_d_camera, v, pose, X, normal) : Eigen::Matrix<double, 1, 6>::Zero();
       const double depth = (v.R_cb * X + v.t_cb).z();
       out.push_back({normal, *edge * scale, J, static_cast<std::uint32_t>(ei), 0.5 * (K.fx + K.fy) / depth});
     }
