@@ -73,6 +73,33 @@ TEST(BoardWorld, MedianCarriesTheCommonHeadingErrorAndItsSigma) {
   EXPECT_TRUE(r.warnings.empty()) << r.warnings.front();
 }
 
+// Two of twelve photos taken while the phone still turned (heading 1.5° off, inside the outlier
+// bound): the median ignores them, and so does its σ. The photos' RMS scatter over √n would make
+// it 0.2°, six times the error it can have.
+TEST(BoardWorld, TheMediansSigmaIgnoresThePhotosTakenInMotion) {
+  Scene s = scene(12, 0.0, 0.05, 6);
+  orientation::OrientationTrack track;
+  for (std::size_t k = 0; k < s.track.size(); ++k) {
+    Quat q = s.track.q_world_device[k];
+    for (const std::size_t i : {3u, 8u})
+      if (std::abs(s.track.t[k] - (s.photos[i].t_shot + s.ci.time_offset_s)) < 0.6)
+        q = Quat(exp_so3(Vec3(0, 0, deg2rad(1.5))) * q.toRotationMatrix());
+    track.push_back(s.track.t[k], q, s.track.covariance[k]);
+  }
+  BoardWorldOptions o;
+  o.common_sigma_rad = Vec2::Zero();  // only what differs between photos
+  Diagnostics d;
+  const auto r = board_world_attitude(s.photos, track, s.ci, o, d);
+  const Vec3 e = log_so3(r.R_world_board * s.R_world_board.transpose());
+  const double sigma = std::sqrt(r.covariance(2, 2));
+  std::printf("heading error %.3f°, σ %.3f°, scatter %.2f°\n", rad2deg(e.z()), rad2deg(sigma), r.heading_scatter_deg);
+  EXPECT_EQ(r.used, 12u);
+  EXPECT_GT(r.heading_scatter_deg, 0.5);
+  EXPECT_LT(std::abs(e.z()), deg2rad(0.05));
+  EXPECT_LT(sigma, deg2rad(0.06));
+  EXPECT_LT(std::abs(e.z()), 3 * sigma);
+}
+
 TEST(BoardWorld, OutliersAndDisturbanceAndOneSidedViewsAreReported) {
   Scene s = scene(10, 0.0, 0.0, 2);
   // A photo whose phone heading was off by 8° (steel): left out, named; the median unmoved.

@@ -1,6 +1,7 @@
 #include "antpose/registration/shape_fit.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 #include <gtest/gtest.h>
@@ -48,6 +49,29 @@ TEST(ShapeFit, TheRadomesRoundingIsFittedAndTheYawWithIt) {
   EXPECT_TRUE(std::any_of(fit.within.begin(), fit.within.end(),
                           [&](std::size_t k) { return fit.radii_m[k] == fit.radius_m && fit.rims_m[k] == fit.rim_m; }));
   EXPECT_GE(fit.spread_board.trace(), 0.0);
+  // The spread weighs the shapes not ruled out by their likelihood against the best's: 1 for the
+  // best, no less than at the paired test's bound for those not ruled out, less for the rest, and
+  // falling away from the best along its rim's radii (the profile has one peak).
+  const EvidenceOptions evidence;
+  const double bound = std::exp(-0.5 * evidence.decisive_z * evidence.decisive_z);
+  ASSERT_EQ(fit.likelihoods.size(), fit.radii_m.size());
+  std::vector<std::pair<double, double>> best_rim;  // (radius, likelihood)
+  for (std::size_t k = 0; k < fit.likelihoods.size(); ++k) {
+    const bool in = std::find(fit.within.begin(), fit.within.end(), k) != fit.within.end();
+    if (fit.radii_m[k] == fit.radius_m && fit.rims_m[k] == fit.rim_m) {
+      EXPECT_EQ(fit.likelihoods[k], 1.0);
+    }
+    EXPECT_EQ(in, fit.likelihoods[k] >= bound * (1 - 1e-12)) << k;
+    if (fit.rims_m[k] == fit.rim_m) best_rim.emplace_back(fit.radii_m[k], fit.likelihoods[k]);
+  }
+  std::sort(best_rim.begin(), best_rim.end());
+  for (std::size_t i = 1; i < best_rim.size(); ++i) {
+    if (best_rim[i].first <= fit.radius_m) {
+      EXPECT_LT(best_rim[i - 1].second, best_rim[i].second) << best_rim[i].first;
+    } else {
+      EXPECT_GT(best_rim[i - 1].second, best_rim[i].second) << best_rim[i].first;
+    }
+  }
 }
 
 // A short panel with end caps standing 8 mm out of its radome, seen from well below over a

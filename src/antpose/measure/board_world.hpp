@@ -9,7 +9,7 @@
 // average out: the orientation track's error (its heading is correlated over the whole capture)
 // and R_device_camera's calibration error are taken at their mean over the photos; what differs
 // between photos (PnP noise, short-term track noise) is the larger of the propagated PnP
-// covariance / N and the photos' scatter / N.
+// covariance / N and the median's own from the photos' robust scatter (board_world.cpp).
 //
 // Warnings: photos whose attitude is far from the median (outliers, named); heading scatter
 // between photos beyond `heading_scatter_warn_deg` (magnetic disturbance); camera positions

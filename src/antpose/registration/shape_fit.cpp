@@ -66,8 +66,17 @@ double parabola_vertex(double at, double step, double a, double b, double c) {
 }
 
 // The shapes the photos do not rule out (pose_evidence.hpp's paired test against the best), and
-// the second moment of their poses' rotations about the best's (rad², board frame).
-std::vector<std::size_t> within(const Profile& p, const Photos& photos, const EvidenceOptions& evidence, Mat3& spread) {
+// the second moment of their poses' rotations about the best's (rad², board frame), each shape
+// weighted by its likelihood relative to the best's, exp(−z²/2), z the paired difference over its
+// standard error (the signed root of the likelihood ratio, about N(0, 1)): the pose averaged over
+// the nuisance shape with its posterior on the grid under a flat prior. Counted alike, the shapes
+// would spread the attitude over the test's whole acceptance region (out to decisive_z), not its
+// one-σ extent. The shapes ruled out stay out: their poses may have slid into another basin, and
+// the z of a units' scatter has no Gaussian tails to give them their due. A difference below
+// min_difference is no evidence however small its scatter, so the standard error is taken as at
+// least the one that makes min_difference borderline.
+std::vector<std::size_t> within(const Profile& p, const Photos& photos, const EvidenceOptions& evidence,
+                                std::vector<double>& likelihoods, Mat3& spread) {
   const auto outline = [&](std::size_t k) {
     PoseEvidence e;
     e.outline = evaluate_outline(p.models[k].mesh_antenna, p.results[k].T_board_antenna, *photos.views, photos.K,
@@ -77,15 +86,22 @@ std::vector<std::size_t> within(const Profile& p, const Photos& photos, const Ev
   };
   const PoseEvidence at_best = outline(p.best);
   const Mat3& R_best = p.results[p.best].T_board_antenna.linear();
+  const double least_error = evidence.min_difference / evidence.decisive_z;
   std::vector<std::size_t> out;
   spread = Mat3::Zero();
+  likelihoods.clear();
+  double weights = 0.0;
   for (std::size_t k = 0; k < p.results.size(); ++k) {
-    if (k != p.best && compare_shape(at_best, outline(k), evidence).decisive) continue;
-    out.push_back(k);
+    const auto c = k == p.best ? Comparison{} : compare_shape(at_best, outline(k), evidence);
+    if (!c.decisive) out.push_back(k);
+    const double z = std::max(c.difference, 0.0) / std::max(c.standard_error, least_error);
+    likelihoods.push_back(std::exp(-0.5 * z * z));
+    if (c.decisive) continue;
     const Vec3 d = log_so3(p.results[k].T_board_antenna.linear() * R_best.transpose());
-    spread += d * d.transpose();
+    spread += likelihoods.back() * d * d.transpose();
+    weights += likelihoods.back();
   }
-  spread /= static_cast<double>(out.size());
+  spread /= weights;
   return out;
 }
 
@@ -134,7 +150,7 @@ ShapeFit fit_shape(const model::AntennaModel& model, const Iso3& T_board_antenna
   fit.model = p.models[p.best];
   fit.outline = p.results[p.best];
   fit.radii_m = p.radii, fit.rims_m = p.rims, fit.scores = p.scores;
-  fit.within = within(p, photos, evidence, fit.spread_board);
+  fit.within = within(p, photos, evidence, fit.likelihoods, fit.spread_board);
   return fit;
 }
 

@@ -13,9 +13,9 @@
 // the shape is profiled over both at once: the pose refined by its outline at full resolution
 // (silhouette.hpp) with the panel's model at each cell of a grid of radii (sharp to half its depth)
 // and rims (none to largest_rim_m), then at the vertex of the profile's parabolas through the best
-// cell; the best shape is kept. The poses of every shape the photos do not rule out
-// (pose_evidence.hpp's paired test) are added to the covariance: the shape is a nuisance whose
-// uncertainty the attitude must carry (a profile likelihood).
+// cell; the best shape is kept. The poses of the other shapes, each weighted by its likelihood
+// relative to the best's (pose_evidence.hpp's paired test), are added to the covariance: the shape
+// is a nuisance whose uncertainty the attitude must carry.
 #pragma once
 
 #include <cstddef>
@@ -47,7 +47,8 @@ struct ShapeFit {
   /// vertex of its parabolas through the best cell; `within`: those the photos do not rule out.
   std::vector<double> radii_m, rims_m, scores;
   std::vector<std::size_t> within;
-  Mat3 spread_board = Mat3::Zero();  // rad², the rotations of the shapes within about the best's
+  std::vector<double> likelihoods;   // per shape tried, relative to the best's (1): the spread's weights
+  Mat3 spread_board = Mat3::Zero();  // rad², the shapes' rotations about the best's, likelihood-weighted
 };
 
 /// Profiles the edge radius and end caps' rim of `model` (a parametric panel; else nothing fitted)
