@@ -43,9 +43,9 @@ double robust_sigma(std::vector<double> residuals) {
 // in three dimensions against the mean's, 1.18 (its efficiency 0.849 for Gaussian data; Brown,
 // "Statistical uses of the spatial median", JRSS B 45, 1983).
 Mat3 l1_median_covariance(const std::vector<Vec3>& residuals) {
-  Vec3 variance = Vec3::Zero();
-  const auto n = static_cast<double>(residuals.size());
   if (residuals.size() < 2) return Mat3::Zero();
+  const auto n = static_cast<double>(residuals.size());
+  Vec3 variance = Vec3::Zero();
   for (int a = 0; a < 3; ++a) {
     std::vector<double> axis;
     for (const Vec3& v : residuals) axis.push_back(v[a]);

@@ -96,8 +96,8 @@ struct CompassOptions {
 /// though the calibrated field there pointed within 0.1° of north (docs/non-contact.md). Here each
 /// photo's tilt is the board's, so only the board's own tilt error e reaches the heading:
 ///   e'_z = −tan(dip) (ĥ · e),   ĥ the field's horizontal direction (world),
-/// and the covariance becomes A Σ Aᵀ + (σ_cal² + s²/n) ẑẑᵀ, A mapping e to e' and s the photos'
-/// heading scatter. Fewer than options.min_photos fields, or a field without a horizontal part:
+/// and the covariance becomes A Σ Aᵀ + (σ_cal² + (π/2) s²/n) ẑẑᵀ, A mapping e to e' and s the
+/// robust scale of the photos' field directions about their median. Fewer than options.min_photos fields, or a field without a horizontal part:
 /// the board is returned unchanged.
 BoardWorldAttitude heading_from_field(BoardWorldAttitude board, const std::vector<Vec3>& field_world_uT,
                                       const CompassOptions& options);

@@ -72,7 +72,7 @@ double parabola_vertex(double at, double step, double a, double b, double c) {
 // the nuisance shape with its posterior on the grid under a flat prior. Counted alike, the shapes
 // would spread the attitude over the test's whole acceptance region (out to decisive_z), not its
 // one-σ extent. The shapes ruled out stay out: their poses may have slid into another basin, and
-// the z of a units' scatter has no Gaussian tails to give them their due. A difference below
+// a z from the units' scatter has no Gaussian tails to give them their due. A difference below
 // min_difference is no evidence however small its scatter, so the standard error is taken as at
 // least the one that makes min_difference borderline.
 std::vector<std::size_t> within(const Profile& p, const Photos& photos, const EvidenceOptions& evidence,
