@@ -3,6 +3,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <vector>
 
@@ -28,6 +29,14 @@ double median(std::vector<T> v) {
   const std::size_t k = v.size() / 2;
   std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
   return static_cast<double>(v[k]);
+}
+
+/// The robust scale of residuals about their centre, 1.4826 · median |r|: σ for Gaussian residuals,
+/// unmoved by a few outsized ones. 0 when there are none.
+template <typename T>
+double robust_sigma(std::vector<T> residuals) {
+  for (T& r : residuals) r = std::abs(r);
+  return 1.4826 * median(std::move(residuals));
 }
 
 }  // namespace antpose

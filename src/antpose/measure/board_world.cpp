@@ -30,18 +30,11 @@ Mat3 track_covariance(const orientation::OrientationTrack& track, double t, cons
   return Vec3(tilt * tilt, tilt * tilt, heading * heading).asDiagonal();
 }
 
-// The robust scale of residuals about their median, 1.4826 · median |r| (Gaussian-consistent).
-// The photos taken while the phone still moved carry outsized errors that the median ignores
-// and an RMS would count in full.
-double robust_sigma(std::vector<double> residuals) {
-  for (double& r : residuals) r = std::abs(r);
-  return 1.4826 * median(residuals);
-}
-
 // The covariance of the L1 median of n rotations from their residuals about it (rad², the
-// residuals' frame): each axis's robust scale, over n, times the spatial median's variance factor
-// in three dimensions against the mean's, 1.18 (its efficiency 0.849 for Gaussian data; Brown,
-// "Statistical uses of the spatial median", JRSS B 45, 1983).
+// residuals' frame): each axis's robust scale (the photos taken while the phone still moved carry
+// outsized errors that the median ignores and an RMS would count in full), over n, times the
+// spatial median's variance factor in three dimensions against the mean's, 1.18 (its efficiency
+// 0.849 for Gaussian data; Brown, "Statistical uses of the spatial median", JRSS B 45, 1983).
 Mat3 l1_median_covariance(const std::vector<Vec3>& residuals) {
   if (residuals.size() < 2) return Mat3::Zero();
   const auto n = static_cast<double>(residuals.size());

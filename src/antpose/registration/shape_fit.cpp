@@ -65,18 +65,18 @@ double parabola_vertex(double at, double step, double a, double b, double c) {
   return curvature > 0 ? at + 0.5 * step * (a - c) / curvature : at;
 }
 
-// The shapes the photos do not rule out (pose_evidence.hpp's paired test against the best), and
-// the second moment of their poses' rotations about the best's (rad², board frame), each shape
-// weighted by its likelihood relative to the best's, exp(−z²/2), z the paired difference over its
-// standard error (the signed root of the likelihood ratio, about N(0, 1)): the pose averaged over
-// the nuisance shape with its posterior on the grid under a flat prior. Counted alike, the shapes
+// Into fit: the shapes the photos do not rule out (pose_evidence.hpp's paired test against the
+// best), each shape's likelihood relative to the best's, exp(−z²/2), z the paired difference over
+// its standard error, and the second moment of the kept shapes' poses' rotations about the best's
+// (rad², board frame) weighted by those likelihoods (z is the signed root of the likelihood ratio,
+// about N(0, 1)): the pose averaged over the nuisance shape with its posterior on the grid under a
+// flat prior. Counted alike, the shapes
 // would spread the attitude over the test's whole acceptance region (out to decisive_z), not its
 // one-σ extent. The shapes ruled out stay out: their poses may have slid into another basin, and
 // a z from the units' scatter has no Gaussian tails to give them their due. A difference below
 // min_difference is no evidence however small its scatter, so the standard error is taken as at
 // least the one that makes min_difference borderline.
-std::vector<std::size_t> within(const Profile& p, const Photos& photos, const EvidenceOptions& evidence,
-                                std::vector<double>& likelihoods, Mat3& spread) {
+void weigh_shapes(const Profile& p, const Photos& photos, const EvidenceOptions& evidence, ShapeFit& fit) {
   const auto outline = [&](std::size_t k) {
     PoseEvidence e;
     e.outline = evaluate_outline(p.models[k].mesh_antenna, p.results[k].T_board_antenna, *photos.views, photos.K,
@@ -87,22 +87,18 @@ std::vector<std::size_t> within(const Profile& p, const Photos& photos, const Ev
   const PoseEvidence at_best = outline(p.best);
   const Mat3& R_best = p.results[p.best].T_board_antenna.linear();
   const double least_error = evidence.min_difference / evidence.decisive_z;
-  std::vector<std::size_t> out;
-  spread = Mat3::Zero();
-  likelihoods.clear();
   double weights = 0.0;
   for (std::size_t k = 0; k < p.results.size(); ++k) {
     const auto c = k == p.best ? Comparison{} : compare_shape(at_best, outline(k), evidence);
-    if (!c.decisive) out.push_back(k);
     const double z = std::max(c.difference, 0.0) / std::max(c.standard_error, least_error);
-    likelihoods.push_back(std::exp(-0.5 * z * z));
+    fit.likelihoods.push_back(std::exp(-0.5 * z * z));
     if (c.decisive) continue;
+    fit.within.push_back(k);
     const Vec3 d = log_so3(p.results[k].T_board_antenna.linear() * R_best.transpose());
-    spread += likelihoods.back() * d * d.transpose();
-    weights += likelihoods.back();
+    fit.spread_board += fit.likelihoods.back() * d * d.transpose();
+    weights += fit.likelihoods.back();
   }
-  spread /= weights;
-  return out;
+  fit.spread_board /= weights;
 }
 
 }  // namespace
@@ -150,7 +146,7 @@ ShapeFit fit_shape(const model::AntennaModel& model, const Iso3& T_board_antenna
   fit.model = p.models[p.best];
   fit.outline = p.results[p.best];
   fit.radii_m = p.radii, fit.rims_m = p.rims, fit.scores = p.scores;
-  fit.within = within(p, photos, evidence, fit.likelihoods, fit.spread_board);
+  weigh_shapes(p, photos, evidence, fit);
   return fit;
 }
 

@@ -36,12 +36,12 @@ struct Normal {
 
 Normal normal_equations(const Gathered& g, double scale, const SilhouetteOptions& o) {
   Normal n;
-  std::vector<double> abs_r;
+  std::vector<double> r;
   for (const auto& v : g.per_view)
-    for (const auto& s : v) abs_r.push_back(std::abs(s.r) / scale);
-  n.samples = abs_r.size();
-  if (abs_r.empty()) return n;
-  const double sigma = std::max(0.5, 1.4826 * median(std::move(abs_r)));
+    for (const auto& s : v) r.push_back(s.r / scale);
+  n.samples = r.size();
+  if (r.empty()) return n;
+  const double sigma = std::max(0.5, robust_sigma(std::move(r)));
   n.c = o.tukey_c * sigma * scale;
   for (const auto& v : g.per_view)
     for (const auto& s : v) {
