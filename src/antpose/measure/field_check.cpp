@@ -53,6 +53,23 @@ std::optional<GradientFit> fit_gradient(const Eigen::MatrixXd& y_rows, const std
 
 }  // namespace
 
+OptionProblems FieldCheckOptions::Check() const {
+  OptionProblems p;
+  for (const auto& [name, value] : {std::pair{"strength_tolerance", strength_tolerance},
+                                    {"dip_tolerance", dip_tolerance},
+                                    {"strength_spread", strength_spread},
+                                    {"dip_spread", dip_spread},
+                                    {"median_dip_tolerance", median_dip_tolerance},
+                                    {"strength_trend", strength_trend},
+                                    {"trend_significance", trend_significance},
+                                    {"vector_trend", vector_trend},
+                                    {"vector_trend_significance", vector_trend_significance},
+                                    {"joint_tolerance", joint_tolerance},
+                                    {"half_window_s", half_window_s}})
+    p.require(value > 0, name, "positive");
+  return p;
+}
+
 std::vector<std::optional<Vec3>> field_at_photos(const orientation::ImuData& data,
                                                  const orientation::OrientationTrack& track,
                                                  const std::vector<double>& t_photos,
@@ -85,6 +102,7 @@ FieldCheck check_field(const std::vector<Vec3>& field_world_uT, const std::optio
   if (!p_world_m.empty() && p_world_m.size() != field_world_uT.size())
     throw std::invalid_argument(
         fmt::format("check_field: {} positions for {} fields", p_world_m.size(), field_world_uT.size()));
+  throw_unless_ok(o.Check(), "FieldCheckOptions");
   FieldCheck c;
   for (std::size_t i = 0; i < field_world_uT.size(); ++i) {
     const Vec3& b = field_world_uT[i];
@@ -133,18 +151,22 @@ FieldCheck check_field(const std::vector<Vec3>& field_world_uT, const std::optio
     }
   }
 
-  const bool off_earth = c.worst_strength_fraction > o.strength_tolerance || c.worst_dip_rad > o.dip_tolerance ||
-                         std::abs(c.median_dip_offset_rad) > o.median_dip_tolerance;
-  const bool trend = c.strength_trend_fraction > o.strength_trend && c.trend_f_statistic > o.trend_significance;
-  const bool vector_trend =
-      c.vector_trend_fraction > o.vector_trend && c.vector_trend_f_statistic > o.vector_trend_significance;
-  const bool uneven =
-      c.strength_spread_fraction > o.strength_spread || c.dip_spread_rad > o.dip_spread || trend || vector_trend;
-  c.disturbed = off_earth || uneven;
+  const double wmm_ratio =
+      std::max(c.worst_strength_fraction / o.strength_tolerance, c.worst_dip_rad / o.dip_tolerance);
+  const double spread_ratio = std::max(c.strength_spread_fraction / o.strength_spread, c.dip_spread_rad / o.dip_spread);
+  c.test_ratios = {
+      wmm_ratio, spread_ratio, std::abs(c.median_dip_offset_rad) / o.median_dip_tolerance,
+      std::min(c.strength_trend_fraction / o.strength_trend, c.trend_f_statistic / o.trend_significance),
+      std::min(c.vector_trend_fraction / o.vector_trend, c.vector_trend_f_statistic / o.vector_trend_significance)};
+  c.joint_ratio = Eigen::Map<const Eigen::Matrix<double, 5, 1>>(c.test_ratios.data()).norm();
+  const bool one_test = std::ranges::any_of(c.test_ratios, [](double r) { return r > 1.0; });
+  const bool jointly = c.joint_ratio > o.joint_tolerance;
+  c.disturbed = one_test || jointly;
   if (!c.disturbed) return c;
   const double horizontal = f_ref * std::cos(dip_ref);
-  if (vector_trend) seen = std::max(seen, vector_fit->change);
+  if (vector_fit) seen = std::max(seen, vector_fit->change);
   c.heading_sigma_rad = seen / std::max(horizontal, 1e-3 * f_ref);
+  const bool trend = c.test_ratios[3] > 1.0, vector_trend = c.test_ratios[4] > 1.0;
   const std::string limits = fmt::format(
       "limits {:.0f} % and {:.1f}° against WMM ({:.1f}° for the median dip), {:.1f} % and {:.1f}° over the photos",
       100 * o.strength_tolerance, rad2deg(o.dip_tolerance), rad2deg(o.median_dip_tolerance), 100 * o.strength_spread,
@@ -162,6 +184,11 @@ FieldCheck check_field(const std::vector<Vec3>& field_world_uT, const std::optio
   if (vector_trend)
     along += fmt::format(", the field vector changing by {:.1f} % of its strength along the walk (limit {:.1f} %)",
                          100 * c.vector_trend_fraction, 100 * o.vector_trend);
+  if (!one_test)
+    along += fmt::format(
+        "; every test is within its limit, but together they are not (root sum of squares of each test's statistic "
+        "over its limit {:.2f}, limit {:.2f})",
+        c.joint_ratio, o.joint_tolerance);
   c.warnings.push_back(fmt::format(
       "magnetic disturbance: at the photos the field {}varies between them by {:.1f} % in strength and {:.1f}° in dip "
       "({}){}: steel nearby turns the compass; the azimuth's σ includes an estimated {:.1f}°, but the error may be "

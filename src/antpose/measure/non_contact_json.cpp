@@ -51,6 +51,8 @@ nlohmann::json field_json(const FieldCheck& f) {
           {"vector_trend_percent", 100 * f.vector_trend_fraction},
           {"vector_trend_f_statistic", f.vector_trend_f_statistic},
           {"median_dip_offset_deg", f.wmm_dip_rad ? nlohmann::json(rad2deg(f.median_dip_offset_rad)) : nullptr},
+          {"test_ratios", f.test_ratios},
+          {"joint_ratio", f.joint_ratio},
           {"disturbed", f.disturbed},
           {"heading_sigma_deg", rad2deg(f.heading_sigma_rad)}};
 }

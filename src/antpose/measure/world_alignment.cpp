@@ -59,7 +59,7 @@ OptionProblems WorldAlignmentOptions::Check() const {
   p.nest("time_offset", time_offset.Check());
   p.require(board_world.min_photos >= 1, "board_world.min_photos", "at least 1");
   p.require(board_world.outlier_deg > 0, "board_world.outlier_deg", "positive");
-  p.require(field.half_window_s > 0, "field.half_window_s", "positive");
+  p.nest("field", field.Check());
   return p;
 }
 
