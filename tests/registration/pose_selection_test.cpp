@@ -153,6 +153,29 @@ TEST(PoseSelection, AMarginThePointsScatterAtTheEndOfTheRangeStillRulesOut) {
   EXPECT_TRUE(s.rivals.empty());
 }
 
+// A pose further off whose outline is decisively better in the photos, beaten by the winner's
+// points alone (as where the region's points are of the mount behind the panel): each half decides
+// against the other, and no weight of the points makes that noise: a rival, though the winner
+// ranks first at either end of the weight's range. Where the outline's margin is within its
+// scatter, the points decide.
+TEST(PoseSelection, AnotherYawWhoseOutlineIsDecisivelyBetterIsARival) {
+  const auto best = with_points(facing(40, Vec3::Zero(), {0.74, 0.71, 0.75, 0.72, 0.73, 0.72}), {0.36, 0.35, 0.37});
+  const auto other = with_points(facing(80, Vec3::Zero(), {0.62, 0.60, 0.63, 0.61, 0.60, 0.62}), {0.86, 0.87, 0.86});
+  const std::vector<PoseEvidence> twins(2, side({0.0, 0.0}));
+  EvidenceOptions outline_light;
+  outline_light.points_weight /= outline_light.points_weight_range;
+  ASSERT_GT(compare_shape(best.evidence, other.evidence, outline_light).difference, 0.0);
+  const Selection s = select_pose({best, other}, twins, std::nullopt, {}, {});
+  EXPECT_EQ(s.best, 0u);
+  ASSERT_EQ(s.rivals.size(), 1u);
+  EXPECT_EQ(s.rivals[0], 1u);
+
+  auto unclear = other;  // better by as much on average, but not in every photo
+  unclear.evidence.outline = {0.40, 0.85, 0.45, 0.80, 0.42, 0.80};
+  unclear.score = unclear.evidence.score({});
+  EXPECT_TRUE(select_pose({best, unclear}, twins, std::nullopt, {}, {}).rivals.empty());
+}
+
 TEST(PoseSelection, AMastBehindDecidesFrontAndBackWhateverTheDowntilt) {
   // The panel 0.4 m north of the mast; as registered it faces south, at its mast: turned round
   // it faces north, away from it. An uptilt as registered changes nothing.

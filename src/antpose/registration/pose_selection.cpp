@@ -71,6 +71,16 @@ bool ranks_first_at_every_weight(const PoseEvidence& best, const PoseEvidence& o
   return true;
 }
 
+// Whether `other`'s outline is decisively better than `best`'s, which then won by its points: the
+// two halves each decide, against each other. One of them is of something else (a mount's points
+// taken for the panel's, a crease taken for a faint outline), and no weight within any range
+// makes that noise: the photos do not say which.
+bool outline_decides_against(const PoseEvidence& best, const PoseEvidence& other, const EvidenceOptions& evidence) {
+  EvidenceOptions outline_only = evidence;
+  outline_only.points_weight = 0.0;
+  return compare_shape(other, best, outline_only).decisive;
+}
+
 }  // namespace
 
 std::string to_string(Strategy strategy) {
@@ -189,7 +199,8 @@ Selection select_pose(const std::vector<PoseCandidate>& candidates, const std::v
     const bool crease_leans =
         c.strategy == Strategy::kCreaseTwin && placement_leans_to(c.evidence, candidates[s.best].evidence, evidence);
     if (!versus.decisive || crease_leans ||
-        !ranks_first_at_every_weight(candidates[s.best].evidence, c.evidence, evidence))
+        !ranks_first_at_every_weight(candidates[s.best].evidence, c.evidence, evidence) ||
+        outline_decides_against(candidates[s.best].evidence, c.evidence, evidence))
       s.rivals.push_back(order[k]);
   }
   if (mast)

@@ -14,7 +14,9 @@
 // points weighed against the outline at either end of the range that weight is known within
 // (EvidenceOptions::points_weight_range): the crease error above, or a mount's points taken for the
 // panel's, is common to every unit of one half and escapes the comparison's noise, so where the two
-// halves point to different poses, the winner must stay first at every weight. The noise test stays
+// halves point to different poses, the winner must stay first at every weight. Where each half
+// decides, against the other (the candidate's outline decisively better, the winner first by its
+// points), one half is of something else and no weight makes that noise: a rival too. The noise test stays
 // at the nominal weight: at the ends of the range one half's scatter swamps the other's, and a
 // margin that is real would read as noise there. A crease twin of the winner (yaw_turns.hpp: turned
 // by atan(depth / width), where a faint side face lets a box lay its outline on the crease) is that
