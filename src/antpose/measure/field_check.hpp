@@ -40,7 +40,7 @@
 // B, along the dip direction, its change along the walk). Together they are a sixth test: each
 // test's statistic over its limit (a two-condition test, 4 or 5, fires only when both are
 // exceeded, so its ratio is the smaller), and the root sum of squares of the five ratios against
-// `joint_tolerance`. Undisturbed, the five vary independently (noise, WMM's error, the track's
+// `joint_tolerance`. Undisturbed, unrelated errors drive them (noise, WMM's error, the track's
 // tilt while walking); under a disturbance they move together.
 // No magnetometer sees a perturbation perpendicular to the horizontal field that is the same at
 // every photo; the tests catch the disturbances that come with a measurable change.
@@ -85,7 +85,7 @@ struct FieldCheckOptions {
   double vector_trend_significance = 8.0;  // F(6, 3(n − 3)); 8.0 is p ≈ 4·10⁻⁵ for 12 photos
   // The joint test (file comment). On 128 undisturbed simulated sites the root sum of squares
   // reached 0.91; a compass turned 3.5° at every photo, with every test between 0.4 and 0.85 of
-  // its limit, gave 1.43; the other 63 disturbed sites 3.0–30.
+  // its limit, gave 1.43; the other 63 disturbed sites 3.0–22.
   double joint_tolerance = 1.2;
   double half_window_s = 0.25;  // magnetometer samples averaged around each photo
 
@@ -124,9 +124,9 @@ std::vector<std::optional<Vec3>> field_at_photos(const orientation::ImuData& dat
                                                  const std::vector<double>& t_photos,
                                                  const std::vector<Mat3>& R_world_device, double half_window_s);
 
-/// The five tests of the file comment, and their joint test, on the photos' fields (µT, world frame). `p_world_m` holds
-/// where each photo was taken (world axes, any origin, m) in the same order, or is empty: then
-/// tests 4 and 5 are skipped.
+/// The five tests of the file comment and their joint test, on the photos' fields (µT, world
+/// frame). `p_world_m` holds where each photo was taken (world axes, any origin, m) in the same
+/// order, or is empty: then tests 4 and 5 are skipped.
 FieldCheck check_field(const std::vector<Vec3>& field_world_uT, const std::optional<geomag::SiteField>& site,
                        const FieldCheckOptions& options, const std::vector<Vec3>& p_world_m = {});
 

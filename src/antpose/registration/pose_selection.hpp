@@ -16,9 +16,9 @@
 // panel's, is common to every unit of one half and escapes the comparison's noise, so where the two
 // halves point to different poses, the winner must stay first at every weight. Where each half
 // decides, against the other (the candidate's outline decisively better, the winner first by its
-// points), one half is of something else and no weight makes that noise: a rival too. The noise test stays
-// at the nominal weight: at the ends of the range one half's scatter swamps the other's, and a
-// margin that is real would read as noise there. A crease twin of the winner (yaw_turns.hpp: turned
+// points), one half is of something else and no weight makes that noise: a rival too. The noise
+// test stays at the nominal weight: at the ends of the range one half's scatter swamps the
+// other's, and a margin that is real would read as noise there. A crease twin of the winner (yaw_turns.hpp: turned
 // by atan(depth / width), where a faint side face lets a box lay its outline on the crease) is that
 // crease error at its full size, often beyond rival_min_deg: it is a rival wherever its placement
 // leans to it as a near candidate's would.
