@@ -18,10 +18,10 @@
 // decides, against the other (the candidate's outline decisively better, the winner first by its
 // points), one half is of something else and no weight makes that noise: a rival too. The noise
 // test stays at the nominal weight: at the ends of the range one half's scatter swamps the
-// other's, and a margin that is real would read as noise there. A crease twin of the winner (yaw_turns.hpp: turned
-// by atan(depth / width), where a faint side face lets a box lay its outline on the crease) is that
-// crease error at its full size, often beyond rival_min_deg: it is a rival wherever its placement
-// leans to it as a near candidate's would.
+// other's, and a margin that is real would read as noise there. A crease twin of the winner
+// (yaw_turns.hpp: turned by atan(depth / width), where a faint side face lets a box lay its
+// outline on the crease) is that crease error at its full size, often beyond rival_min_deg: it is
+// a rival wherever its placement leans to it as a near candidate's would.
 // Then front and back, which the box's outline cannot tell: the winner against its twin turned
 // by 180° about its long axis. A known mast decides first where it stands clearly behind one of
 // them (a panel's back plate faces its mount); otherwise the side units (the vertical structure
