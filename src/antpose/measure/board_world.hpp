@@ -97,8 +97,8 @@ struct CompassOptions {
 /// photo's tilt is the board's, so only the board's own tilt error e reaches the heading:
 ///   e'_z = −tan(dip) (ĥ · e),   ĥ the field's horizontal direction (world),
 /// and the covariance becomes A Σ Aᵀ + (σ_cal² + (π/2) s²/n) ẑẑᵀ, A mapping e to e' and s the
-/// robust scale of the photos' field directions about their median. Fewer than options.min_photos fields, or a field without a horizontal part:
-/// the board is returned unchanged.
+/// robust scale of the photos' field directions about their median. Fewer than options.min_photos
+/// fields, or a field without a horizontal part: the board is returned unchanged.
 BoardWorldAttitude heading_from_field(BoardWorldAttitude board, const std::vector<Vec3>& field_world_uT,
                                       const CompassOptions& options);
 

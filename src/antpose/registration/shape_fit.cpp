@@ -70,12 +70,11 @@ double parabola_vertex(double at, double step, double a, double b, double c) {
 // its standard error, and the second moment of the kept shapes' poses' rotations about the best's
 // (rad², board frame) weighted by those likelihoods (z is the signed root of the likelihood ratio,
 // about N(0, 1)): the pose averaged over the nuisance shape with its posterior on the grid under a
-// flat prior. Counted alike, the shapes
-// would spread the attitude over the test's whole acceptance region (out to decisive_z), not its
-// one-σ extent. The shapes ruled out stay out: their poses may have slid into another basin, and
-// a z from the units' scatter has no Gaussian tails to give them their due. A difference below
-// min_difference is no evidence however small its scatter, so the standard error is taken as at
-// least the one that makes min_difference borderline.
+// flat prior. Counted alike, the shapes would spread the attitude over the test's whole acceptance
+// region (out to decisive_z), not its one-σ extent. The shapes ruled out stay out: their poses may
+// have slid into another basin, and a z from the units' scatter has no Gaussian tails to give them
+// their due. A difference below min_difference is no evidence however small its scatter, so the
+// standard error is taken as at least the one that makes min_difference borderline.
 void weigh_shapes(const Profile& p, const Photos& photos, const EvidenceOptions& evidence, ShapeFit& fit) {
   const auto outline = [&](std::size_t k) {
     PoseEvidence e;
