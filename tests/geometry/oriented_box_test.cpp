@@ -55,5 +55,31 @@ TEST(OrientedBox, AgreesWithSamplesOfTheBoxes) {
   EXPECT_GT(together, 40);
 }
 
+// Against the distances of dense samples along random segments: never more than the nearest
+// sample's, never less by more than the sample spacing allows; zero where a sample lies inside.
+TEST(OrientedBox, SegmentDistanceAgreesWithSamplesOfTheSegment) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const OrientedBox box = panel(Vec3(0.1, -0.2, 0.3), 35, 8);
+  const auto point_distance = [&](const Vec3& p) {
+    return ((box.T_frame_box.inverse() * p).cwiseAbs() - box.size_m / 2).cwiseMax(0.0).norm();
+  };
+  int meeting = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    const Vec3 a = 2 * Vec3(u(rng), u(rng), u(rng)), b = 2 * Vec3(u(rng), u(rng), u(rng));
+    double nearest = 1e9;
+    const int n = 4000;
+    for (int k = 0; k <= n; ++k) nearest = std::min(nearest, point_distance(a + (b - a) * (double(k) / n)));
+    const double d = box_segment_distance(box, a, b);
+    EXPECT_LE(d, nearest + 1e-9) << "trial " << trial;
+    EXPECT_GE(d, nearest - (b - a).norm() / n) << "trial " << trial;
+    meeting += nearest == 0.0;
+  }
+  EXPECT_GT(meeting, 20);
+  // A vertical pipe 0.2 m behind a panel's back face, and one through it.
+  EXPECT_NEAR(box_segment_distance(panel(Vec3::Zero(), 0), Vec3(0, 0.275, -3), Vec3(0, 0.275, 3)), 0.2, 1e-9);
+  EXPECT_EQ(box_segment_distance(panel(Vec3::Zero(), 0), Vec3(0, 0.05, -3), Vec3(0, 0.05, 3)), 0.0);
+}
+
 }  // namespace
 }  // namespace antpose

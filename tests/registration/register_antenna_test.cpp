@@ -220,8 +220,6 @@ TEST(RegisterAntenna, ThePointsPoseIsKeptWhereThePointsPlaceIt) {
   EXPECT_FALSE(std::isfinite(held(without)));
 }
 
-// Two panels cannot share volume: with a neighbour known where this panel hangs, no candidate
-// passes through it, and the panel is not found there.
 TEST(RegisterAntenna, AContinuingRegistrationMakesNoTurnsOfItsOwn) {
   RegisterOptions o;
   ASSERT_GT(o.turns.of_best, 0u);
@@ -232,6 +230,8 @@ TEST(RegisterAntenna, AContinuingRegistrationMakesNoTurnsOfItsOwn) {
   EXPECT_TRUE(c.Check().ok());
 }
 
+// Two panels cannot share volume: with a neighbour known where this panel hangs, no candidate
+// passes through it, and the panel is not found there.
 TEST(RegisterAntenna, NoCandidatePassesThroughAKnownNeighbour) {
   const SyntheticScene s = make_scene();
   AntennaScene scene = antenna_scene_with_mast(s);
@@ -247,6 +247,36 @@ TEST(RegisterAntenna, NoCandidatePassesThroughAKnownNeighbour) {
   if (r.found) {
     EXPECT_GT((r.T_board_antenna.translation() - s.T_board_antenna.translation()).norm(), 0.05);
   }
+}
+
+// No panel hangs inside its mast: with the known mast standing where the panel's outline is
+// (its axis through the panel's centre), every pose that fits the outline hangs in it, and the
+// result is no answer that says so, marked as the mast's (not to be retried without it).
+TEST(RegisterAntenna, EveryPoseInTheKnownMastIsNoAnswer) {
+  const SyntheticScene s = make_scene();
+  AntennaScene scene = antenna_scene_with_mast(s);
+  scene.mast->axis_point_board = s.T_board_antenna.translation();
+  scene.mast->radius_m = 0.06;
+  const auto r = register_antenna(model::parametric_panel({}), scene, {});
+  ASSERT_FALSE(r.found) << "found "
+                        << rad2deg(rotation_distance(r.T_board_antenna.linear(), s.T_board_antenna.linear()))
+                        << "° from the panel";
+  EXPECT_TRUE(r.against_mast);
+  EXPECT_NE(r.why_not.find("hangs against or through the mast found behind it:"), std::string::npos) << r.why_not;
+}
+
+// With the mast where it stands, the panel's poses stand clear of it and are kept: the panel is
+// found as without the check.
+TEST(RegisterAntenna, AMastBehindThePanelDropsNoPoseOfIt) {
+  const SyntheticScene s = make_scene();
+  const AntennaScene scene = antenna_scene_with_mast(s);
+  RegisterOptions without;
+  without.min_mast_gap_m = -1.0;  // never dropped
+  const auto r = register_antenna(model::parametric_panel({}), scene, {});
+  const auto u = register_antenna(model::parametric_panel({}), scene, without);
+  ASSERT_TRUE(r.found && u.found);
+  EXPECT_FALSE(r.against_mast);
+  EXPECT_LT(rad2deg(rotation_distance(r.T_board_antenna.linear(), u.T_board_antenna.linear())), 0.01);
 }
 
 // Where no pose meets its outline well, the poses that meet it faintly are measured, with a

@@ -1,5 +1,6 @@
 #include "antpose/geometry/oriented_box.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace antpose {
@@ -25,6 +26,25 @@ bool boxes_overlap(const OrientedBox& a, const OrientedBox& b, double gap_m) {
       if (std::abs(t(i2) * R(i1, j) - t(i1) * R(i2, j)) > ra + rb + gap_m * length) return false;
     }
   return true;
+}
+
+double box_segment_distance(const OrientedBox& box, const Vec3& a, const Vec3& b) {
+  const Iso3 T_box_frame = box.T_frame_box.inverse();
+  const Vec3 half = box.size_m / 2;
+  const auto distance = [&](double t) {
+    const Vec3 q = T_box_frame * (a + t * (b - a));
+    return (q.cwiseAbs() - half).cwiseMax(0.0).norm();
+  };
+  const double ratio = (std::sqrt(5.0) - 1) / 2;
+  double lo = 0.0, hi = 1.0;
+  for (int i = 0; i < 60; ++i) {
+    const double m1 = hi - ratio * (hi - lo), m2 = lo + ratio * (hi - lo);
+    if (distance(m1) <= distance(m2))
+      hi = m2;
+    else
+      lo = m1;
+  }
+  return distance((lo + hi) / 2);
 }
 
 std::optional<OrientedBox> shrunk(const OrientedBox& box, double by_m) {

@@ -19,6 +19,11 @@ struct OrientedBox {
 /// Lin & Manocha, "OBBTree", SIGGRAPH 1996).
 bool boxes_overlap(const OrientedBox& a, const OrientedBox& b, double gap_m = 0.0);
 
+/// The shortest distance between the box (solid) and the segment from `a` to `b` (one frame); 0
+/// where they meet. The distance from a convex set is convex along a line, so a golden-section
+/// search over the segment finds its minimum.
+double box_segment_distance(const OrientedBox& box, const Vec3& a, const Vec3& b);
+
 /// The box shrunk by `by_m` on every face; nullopt where nothing is left of it.
 std::optional<OrientedBox> shrunk(const OrientedBox& box, double by_m);
 

@@ -365,7 +365,8 @@ void measure_antenna(AntennaMeasurement& m, const model::AntennaModel* model, co
           mast && !known(*mast)) {
         objects.mast = m.mast = std::move(mast);
         auto with_mast = register_with_mast(*model, scene.points_board.size(), r.candidates, m, c, objects, o);
-        if (with_mast.found) r = std::move(with_mast);
+        // Where every pose that fits hangs against the mast, the first registration found the mast.
+        if (with_mast.found || with_mast.against_mast) r = std::move(with_mast);
       }
     if (!r.found) {
       m.error = r.why_not;

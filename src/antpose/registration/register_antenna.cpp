@@ -159,32 +159,53 @@ bool passes_through_neighbour(const OrientedBox& box, const std::vector<Oriented
          });
 }
 
-// The best outline among the refined candidates centred in the rectangle but spanning too little
-// of it (distinct_in_rectangle), and its span: where it fits clearly and nothing that spans the
-// rectangle does, the rectangle is drawn too loosely, not the photos unclear.
-struct TooSmallInRectangle {
-  double score = 1.0, span = 0.0;
-  void note(double outline_score, double rectangle_span) {
-    if (outline_score < score) score = outline_score, span = rectangle_span;
+// What distinct_in_rectangle drops that a refusal may have to explain:
+//  - the best outline among the candidates centred in the rectangle but spanning too little of it,
+//    and its span: where it fits clearly and nothing that spans the rectangle does, the rectangle
+//    is drawn too loosely, not the photos unclear;
+//  - the candidates against the known mast whose outline fits at least faintly: where nothing
+//    else fits, the outline found is the mast's and its clamps', not the panel's.
+struct Dropped {
+  double small_score = 1.0, small_span = 0.0;
+  std::size_t against_mast = 0;
+  void too_small(double outline_score, double rectangle_span) {
+    if (outline_score < small_score) small_score = outline_score, small_span = rectangle_span;
   }
 };
 
-// Refined candidates that fit the rectangle and pass through no known neighbour, one per place: of
+// The gap between the panel, its box with the vertical edges rounded by `edge_radius_m`, and the
+// mast's surface over the mast's extent; negative where they overlap.
+double mast_gap(const OrientedBox& box, double edge_radius_m, const reconstruction::Mast& mast) {
+  OrientedBox core = box;
+  core.size_m.head<2>().array() -= 2 * std::min(edge_radius_m, box.size_m.head<2>().minCoeff() / 2);
+  const Vec3 low = mast.axis_point_board + mast.low_m * mast.up_board;
+  const Vec3 high = mast.axis_point_board + mast.high_m * mast.up_board;
+  const double gap = box_segment_distance(core, low, high) - edge_radius_m - mast.radius_m;
+  return gap;
+}
+
+// Refined candidates that fit the rectangle and pass through neither a known neighbour nor the
+// known mast, one per place: of
 // those ending at the same box pose, the one whose outline fits best, or the best with a profiled
 // shape where one has it (the shape is the panel's; a descent with the model's guessed one is no
 // better evidence of the pose). Best outline first.
 std::vector<Refined> distinct_in_rectangle(std::vector<Refined> refined, const model::AntennaModel& model,
-                                           const AntennaScene& s, const RegisterOptions& o,
-                                           TooSmallInRectangle& too_small) {
+                                           const AntennaScene& s, const RegisterOptions& o, Dropped& dropped) {
   std::sort(refined.begin(), refined.end(), fits_better);
   std::vector<Refined> out;
   for (auto& r : refined) {
     const Iso3& T = r.candidate.T_board_antenna;
     const auto fit = roi_span(model.size_m, T, s.views[s.region_view], s.intrinsics, s.roi);
     if (fit.centred && fit.span < o.min_roi_span && r.outline.views_used >= o.min_outline_views)
-      too_small.note(r.outline.score, fit.span);
+      dropped.too_small(r.outline.score, fit.span);
     if (fit.span < o.min_roi_span || !fit.centred) continue;
     if (passes_through_neighbour({T, model.size_m}, s.neighbours_board, o.neighbour_clearance_m)) continue;
+    const double rounding = r.model->panel ? r.model->panel->edge_radius_m : 0.0;
+    if (s.mast && mast_gap({T, model.size_m}, rounding, *s.mast) < o.min_mast_gap_m) {
+      dropped.against_mast +=
+          r.outline.views_used >= o.min_outline_views && r.outline.score <= o.max_faint_outline_score;
+      continue;
+    }
     const auto known = std::find_if(out.begin(), out.end(), [&](const Refined& k) {
       return same_place(T, k.candidate.T_board_antenna, o.same_pose_deg, o.same_pose_m);
     });
@@ -270,8 +291,8 @@ std::vector<PoseCandidate> slid_proposals(const std::vector<Refined>& kept, cons
 // long axis (turned_proposals, placed_turns) or slid along it (slid_proposals) and refined too.
 std::vector<Refined> refine_and_turn(const std::shared_ptr<const model::AntennaModel>& shared, const AntennaScene& s,
                                      const std::vector<PoseCandidate>& proposals, const RegisterOptions& o,
-                                     TooSmallInRectangle& too_small) {
-  auto kept = distinct_in_rectangle(refine_all(shared, s, proposals, o), *shared, s, o, too_small);
+                                     Dropped& dropped) {
+  auto kept = distinct_in_rectangle(refine_all(shared, s, proposals, o), *shared, s, o, dropped);
   auto turned = turned_proposals(kept, s, o);
   if (auto facing = facing_mast_proposal(kept, s, o)) turned.push_back(std::move(*facing));
   const auto placed = placed_turns(turned, kept, *shared, s, o);
@@ -289,7 +310,7 @@ std::vector<Refined> refine_and_turn(const std::shared_ptr<const model::AntennaM
   });
   kept.insert(kept.end(), std::make_move_iterator(more.begin()), std::make_move_iterator(more.end()));
   kept.insert(kept.end(), std::make_move_iterator(moved.begin()), std::make_move_iterator(moved.end()));
-  return distinct_in_rectangle(std::move(kept), *shared, s, o, too_small);
+  return distinct_in_rectangle(std::move(kept), *shared, s, o, dropped);
 }
 
 // The best candidates' shape (edge rounding, end caps) profiled with their poses (shape_fit.hpp),
@@ -342,8 +363,7 @@ void fit_shapes(std::vector<Refined>& kept, const AntennaScene& s, const Registe
 // The best candidate's crease twins (yaw_turns.hpp) with its model, placed by the outline at their
 // own turn (refine_all), where they fit the rectangle and no candidate stands yet; their own shape
 // is profiled next (fit_shapes).
-void add_crease_twins(std::vector<Refined>& kept, const AntennaScene& s, const RegisterOptions& o,
-                      TooSmallInRectangle& too_small) {
+void add_crease_twins(std::vector<Refined>& kept, const AntennaScene& s, const RegisterOptions& o, Dropped& dropped) {
   if (!o.crease_twins || kept.empty()) return;
   const auto best_it = best_outline(kept);
   const auto with = best_it->model;
@@ -356,7 +376,7 @@ void add_crease_twins(std::vector<Refined>& kept, const AntennaScene& s, const R
     return stands_among(m.candidate.T_board_antenna, kept, o.same_pose_deg, o.same_pose_m);
   });
   kept.insert(kept.end(), std::make_move_iterator(placed.begin()), std::make_move_iterator(placed.end()));
-  kept = distinct_in_rectangle(std::move(kept), *with, s, o, too_small);
+  kept = distinct_in_rectangle(std::move(kept), *with, s, o, dropped);
 }
 
 // The candidates whose outline meets the photos' edges at least faintly (max_faint_outline_score,
@@ -535,6 +555,7 @@ OptionProblems RegisterOptions::Check() const {
   p.require(refine_candidates >= 1, "refine_candidates", "at least 1");
   p.require(same_pose_deg >= 0 && same_pose_m >= 0, "same_pose_deg, same_pose_m", "≥ 0");
   p.require(neighbour_clearance_m >= 0, "neighbour_clearance_m", "≥ 0");
+  p.require(std::isfinite(min_mast_gap_m), "min_mast_gap_m", "finite (negative: a panel may reach that far into it)");
   p.require(min_roi_span > 0 && min_roi_span <= 1, "min_roi_span", "in (0, 1]");
   p.require(max_outline_score > 0 && max_outline_score <= max_faint_outline_score && max_faint_outline_score <= 1,
             "max_outline_score, max_faint_outline_score", "0 < max_outline_score ≤ max_faint_outline_score ≤ 1");
@@ -572,19 +593,30 @@ AntennaRegistration register_antenna(const model::AntennaModel& model, const Ant
   throw_unless_ok(o.Check(), "RegisterOptions");
   check_scene(s);
   const auto shared = std::make_shared<const model::AntennaModel>(model);
-  TooSmallInRectangle too_small;
-  auto kept = refine_and_turn(shared, s, proposals, o, too_small);
-  add_crease_twins(kept, s, o, too_small);
+  Dropped dropped;
+  auto kept = refine_and_turn(shared, s, proposals, o, dropped);
+  add_crease_twins(kept, s, o, dropped);
   fit_shapes(kept, s, o);
   keep_fitting_outlines(kept, s, o);
   const auto best = best_outline(kept);
-  if ((best == kept.end() || best->outline.score > o.max_outline_score) && too_small.score <= o.max_outline_score) {
+  if ((best == kept.end() || best->outline.score > o.max_outline_score) && dropped.small_score <= o.max_outline_score) {
     return not_found(
         proposals.size(),
         fmt::format("a pose of the model '{}' fits its outline clearly (score {:.2f}) but spans only {:.0f} % of the "
                     "rectangle's longer side (a rectangle drawn around it: at least {:.0f} %), and no pose that spans "
                     "it fits more than faintly: is the rectangle drawn closely around the whole antenna?",
-                    model.name, too_small.score, 100 * too_small.span, 100 * o.min_roi_span));
+                    model.name, dropped.small_score, 100 * dropped.small_span, 100 * o.min_roi_span));
+  }
+  if (kept.empty() && dropped.against_mast > 0) {
+    auto none = not_found(
+        proposals.size(),
+        fmt::format("every pose of the model '{}' that fits an outline in the rectangle ({}) hangs against or through "
+                    "the mast found behind it: the edges found are the mast's and its clamps', and the panel's own do "
+                    "not stand out from the background in these photos; photos with the panel against a contrasting "
+                    "background (a wall, or the sky from another side) would help",
+                    model.name, dropped.against_mast));
+    none.against_mast = true;
+    return none;
   }
   if (kept.empty()) {
     return not_found(

@@ -21,7 +21,7 @@
 // at least `min_roi_span` of the rectangle's larger side and has its centre inside it (the
 // rectangle was drawn around this antenna, so a pose on a neighbour or the mast does not
 // qualify); its box must not pass through a known neighbour's (neighbour_clearance_m: two panels
-// cannot share volume); and its outline must meet the photos' edges at least faintly
+// cannot share volume) nor against the known mast (min_mast_gap_m); and its outline must meet the photos' edges at least faintly
 // (max_faint_outline_score, min_outline_views). Among
 // those, only the comparison with the best (pose_selection.hpp) rules a candidate out: a fixed
 // score cut would drop the true pose wherever the edges are faint or cluttered and a wrong pose
@@ -86,6 +86,10 @@ struct RegisterOptions {
   /// A candidate whose box, and a neighbour's, each shrunk by this on every face, still meet passes
   /// through that neighbour: no panel hangs there (the neighbour's own pose is known to a few cm).
   double neighbour_clearance_m = 0.05;
+  /// A candidate whose panel (its box, the long edges rounded) comes closer to a known mast's
+  /// surface than this hangs where no mount holds it: clamp, bracket and arm hold a panel's back
+  /// at least 4–5 cm off its pipe, and the mast's outline and the pose fix the gap to a centimetre.
+  double min_mast_gap_m = 0.02;
   /// The refinement: no restarts of its own (the strategies span the yaws), a trust region on the
   /// rotation, and a neighbour or the mast may hide part of the outline.
   SilhouetteOptions refine = [] {
@@ -126,6 +130,9 @@ std::string to_string(RegistrationVerdict verdict);  // "unique", "ambiguous", "
 struct AntennaRegistration {
   bool found = false;
   std::string why_not;  // when not found: why, and what would help
+  /// Not found because every candidate that fits hangs against the known mast (min_mast_gap_m):
+  /// what was found is the mast, and a registration without the mast known would only find it again.
+  bool against_mast = false;
   Iso3 T_board_antenna = Iso3::Identity();
   /// The pose's rotation covariance by its sources (rad², board frame): the outline's parts
   /// (silhouette.hpp OutlineCovarianceParts) and the profiled shape's spread.
