@@ -180,15 +180,13 @@ double mast_gap(const OrientedBox& box, double edge_radius_m, const reconstructi
   core.size_m.head<2>().array() -= 2 * std::min(edge_radius_m, box.size_m.head<2>().minCoeff() / 2);
   const Vec3 low = mast.axis_point_board + mast.low_m * mast.up_board;
   const Vec3 high = mast.axis_point_board + mast.high_m * mast.up_board;
-  const double gap = box_segment_distance(core, low, high) - edge_radius_m - mast.radius_m;
-  return gap;
+  return box_segment_distance(core, low, high) - edge_radius_m - mast.radius_m;
 }
 
-// Refined candidates that fit the rectangle and pass through neither a known neighbour nor the
-// known mast, one per place: of
-// those ending at the same box pose, the one whose outline fits best, or the best with a profiled
-// shape where one has it (the shape is the panel's; a descent with the model's guessed one is no
-// better evidence of the pose). Best outline first.
+// Refined candidates that fit the rectangle, pass through no known neighbour and stand clear of
+// the known mast, one per place: of those ending at the same box pose, the one whose outline fits
+// best, or the best with a profiled shape where one has it (the shape is the panel's; a descent
+// with the model's guessed one is no better evidence of the pose). Best outline first.
 std::vector<Refined> distinct_in_rectangle(std::vector<Refined> refined, const model::AntennaModel& model,
                                            const AntennaScene& s, const RegisterOptions& o, Dropped& dropped) {
   std::sort(refined.begin(), refined.end(), fits_better);

@@ -21,14 +21,15 @@
 // at least `min_roi_span` of the rectangle's larger side and has its centre inside it (the
 // rectangle was drawn around this antenna, so a pose on a neighbour or the mast does not
 // qualify); its box must not pass through a known neighbour's (neighbour_clearance_m: two panels
-// cannot share volume) nor against the known mast (min_mast_gap_m); and its outline must meet the photos' edges at least faintly
-// (max_faint_outline_score, min_outline_views). Among
-// those, only the comparison with the best (pose_selection.hpp) rules a candidate out: a fixed
-// score cut would drop the true pose wherever the edges are faint or cluttered and a wrong pose
-// meets other edges a little better, leaving that wrong pose unique. The result's faces are then
-// checked against the region's points (face_plane.hpp). "Not found" is a value: the result says
-// why and what photo or rectangle would help, and a pose that fits clearly but spans too little of
-// a rectangle in which nothing else fits more than faintly says the rectangle is drawn too loosely.
+// cannot share volume) nor come against the known mast (min_mast_gap_m: a clamp holds it off its
+// pipe); and its outline must meet the photos' edges at least faintly (max_faint_outline_score,
+// min_outline_views). Among those, only the comparison with the best (pose_selection.hpp) rules a
+// candidate out: a fixed score cut would drop the true pose wherever the edges are faint or
+// cluttered and a wrong pose meets other edges a little better, leaving that wrong pose unique.
+// The result's faces are then checked against the region's points (face_plane.hpp). "Not found"
+// is a value: the result says why and what photo or rectangle would help; a pose that fits clearly
+// but spans too little of a rectangle in which nothing else fits more than faintly says the
+// rectangle is drawn too loosely, and poses that fit only against the mast say the mast was found.
 #pragma once
 
 #include <cstddef>
