@@ -380,6 +380,23 @@ TEST_F(SimWideCapture, PhotosAreOfTheResizedCamera) {
   EXPECT_EQ(img.rows, K.height);
 }
 
+// The recording's accelerometer and gyroscope offsets have moved from the phone's own (which its
+// calibration captures show) by about their 1σ of 1.5 mg and 0.05 °/s per axis, and the truth
+// says so.
+TEST_F(SimWideCapture, TheImuOffsetsAreTheRecordingsNotTheCalibrations) {
+  CaptureScenario sc;
+  const SimulatedDevice calibrated = make_device(sc.device, 11);
+  const Vec3 acc = sim_->device.phone.accelerometer.bias - calibrated.phone.accelerometer.bias;
+  const Vec3 gyro = sim_->device.phone.gyroscope.bias - calibrated.phone.gyroscope.bias;
+  EXPECT_GT(acc.cwiseAbs().minCoeff(), 1e-6);
+  EXPECT_LT(acc.cwiseAbs().maxCoeff(), 5 * 1.5e-3 * 9.80665);
+  EXPECT_GT(gyro.cwiseAbs().minCoeff(), 1e-9);
+  EXPECT_LT(gyro.cwiseAbs().maxCoeff(), 5 * deg2rad(0.05));
+  const YAML::Node device = YAML::LoadFile((folder() / "truth/device.yaml").string());
+  for (int i = 0; i < 3; ++i)
+    EXPECT_NEAR(device["accelerometer"]["bias"][i].as<double>(), sim_->device.phone.accelerometer.bias(i), 1e-6);
+}
+
 TEST_F(SimWideCapture, TruthRoiHoldsTheRenderedPanel) {
   const YAML::Node scene = YAML::LoadFile((folder() / "truth/scene.yaml").string());
   EXPECT_EQ(scene["distribution"].as<std::string>(), "wide");

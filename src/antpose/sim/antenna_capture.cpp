@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <random>
 #include <stdexcept>
 
 #include <fmt/format.h>
@@ -144,6 +145,18 @@ void apply_site(SimulatedDevice& d, const SiteDraw& site) {
   d.sensor.gain = site.light.gain;
 }
 
+// This recording's accelerometer and gyroscope offsets against the phone's calibration. A MEMS
+// offset moves with temperature (zero-g level about 0.1–0.5 mg/K, zero-rate level 0.01–0.05 °/s/K
+// in phone IMUs' datasheets: ST LSM6DSO, LSM6DS3) and from one power-up to the next, and a site
+// is photographed days and kelvins away from the phone's calibration: 1σ per axis 1.5 mg and
+// 0.05 °/s. From a stream of its own, so a seed's scene and walk are not changed by it.
+void shift_offsets(SimulatedDevice& d, std::uint64_t seed) {
+  auto rng = make_rng(seed, 0xb1a5, kWalkStreams);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  for (int i = 0; i < 3; ++i) d.phone.accelerometer.bias(i) += 1.5e-3 * 9.80665 * normal(rng);
+  for (int i = 0; i < 3; ++i) d.phone.gyroscope.bias(i) += deg2rad(0.05) * normal(rng);
+}
+
 }  // namespace
 
 AntennaSitePlan plan_classic_antenna_site(const CaptureScenario& sc, const SimulatedDevice& d,
@@ -261,6 +274,7 @@ AntennaSitePlan plan_wide_antenna_site(const CaptureScenario& sc, SimulatedDevic
                                views->poses, site.layout, K))
       continue;
     apply_site(d, site);
+    shift_offsets(d, sc.seed);
     plan.board = pl;
     std::vector<Waypoint> waypoints;
     for (const auto& pose : views->poses)
