@@ -365,7 +365,12 @@ void measure_antenna(AntennaMeasurement& m, const model::AntennaModel* model, co
           mast && !known(*mast)) {
         objects.mast = m.mast = std::move(mast);
         auto with_mast = register_with_mast(*model, scene.points_board.size(), r.candidates, m, c, objects, o);
-        // Where every pose that fits hangs against the mast, the first registration found the mast.
+        // With the mast known, every pose that fits hangs against it, or none fits and the first
+        // answer does: either way the first registration found the mast, not the panel.
+        const auto& answer_model = r.panel_shape ? r.panel_shape->model : *model;
+        if (!with_mast.found && !with_mast.against_mast &&
+            registration::mast_gap(answer_model, r.T_board_antenna, *m.mast) < o.registration.min_mast_gap_m)
+          with_mast = registration::found_only_the_mast(*model, with_mast.proposed);
         if (with_mast.found || with_mast.against_mast) r = std::move(with_mast);
       }
     if (!r.found) {

@@ -576,6 +576,22 @@ Mat3 AntennaRegistration::rotation_covariance_board() const {
   return sum;
 }
 
+double mast_gap(const model::AntennaModel& model, const Iso3& T_board_antenna, const reconstruction::Mast& mast) {
+  return mast_gap({T_board_antenna, model.size_m}, model.panel ? model.panel->edge_radius_m : 0.0, mast);
+}
+
+AntennaRegistration found_only_the_mast(const model::AntennaModel& model, std::size_t proposed) {
+  auto none = not_found(
+      proposed,
+      fmt::format("every pose of the model '{}' that fits an outline in the rectangle hangs against or through the "
+                  "mast found behind it: the edges found are the mast's and its clamps', and the panel's own do not "
+                  "stand out from the background in these photos; photos with the panel against a contrasting "
+                  "background (a wall, or the sky from another side) would help",
+                  model.name));
+  none.against_mast = true;
+  return none;
+}
+
 RegisterOptions continuing(RegisterOptions options) {
   options.turns.of_best = 0;
   return options;
@@ -605,17 +621,7 @@ AntennaRegistration register_antenna(const model::AntennaModel& model, const Ant
                     "it fits more than faintly: is the rectangle drawn closely around the whole antenna?",
                     model.name, dropped.small_score, 100 * dropped.small_span, 100 * o.min_roi_span));
   }
-  if (kept.empty() && dropped.against_mast > 0) {
-    auto none = not_found(
-        proposals.size(),
-        fmt::format("every pose of the model '{}' that fits an outline in the rectangle ({}) hangs against or through "
-                    "the mast found behind it: the edges found are the mast's and its clamps', and the panel's own do "
-                    "not stand out from the background in these photos; photos with the panel against a contrasting "
-                    "background (a wall, or the sky from another side) would help",
-                    model.name, dropped.against_mast));
-    none.against_mast = true;
-    return none;
-  }
+  if (kept.empty() && dropped.against_mast > 0) return found_only_the_mast(model, proposals.size());
   if (kept.empty()) {
     return not_found(
         proposals.size(),

@@ -170,6 +170,14 @@ std::vector<PoseCandidate> propose_poses(const model::AntennaModel& model, const
 AntennaRegistration register_antenna(const model::AntennaModel& model, const AntennaScene& scene,
                                      const RegisterOptions& options, const std::vector<PoseCandidate>& proposals);
 
+/// The gap between the panel of `model` at `T_board_antenna` (its box, the long edges rounded) and
+/// the mast's surface over the mast's extent (m); negative where they overlap.
+double mast_gap(const model::AntennaModel& model, const Iso3& T_board_antenna, const reconstruction::Mast& mast);
+
+/// "Not found", marked against_mast: every pose of `model` that fits an outline hangs against or
+/// through the known mast (RegisterOptions::min_mast_gap_m), so the outline found is the mast's.
+AntennaRegistration found_only_the_mast(const model::AntennaModel& model, std::size_t proposed);
+
 /// The options of a registration that starts from an earlier one's candidates: those hold the
 /// earlier one's turns, so it makes none of its own (`turns.of_best = 0`).
 RegisterOptions continuing(RegisterOptions options);
