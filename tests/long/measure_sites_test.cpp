@@ -10,8 +10,9 @@
 // always says what to do. The accuracy targets are over a whole
 // set (MeasureSiteSet below).
 //
-// Sites: the everyday list (CI) holds wide-distribution development sites and regression sites of
-// the classic distribution. ANTPOSE_MEASURE_SET=FIRST-LAST (e.g. 7101-7112) replaces it by a set of
+// Sites: the everyday list (CI) holds wide-distribution development sites, one of them a site that
+// must be refused with a given reason, and regression sites of the classic distribution.
+// ANTPOSE_MEASURE_SET=FIRST-LAST (e.g. 7101-7112) replaces it by a set of
 // wide sites drawn alike (rooftop and ground alternating, 1–3 antennas, a magnetised mast at every
 // third; 2 MP photos, plain radomes and side-by-side panels forced in turn), and
 // ANTPOSE_MEASURE_RESULTS=DIR keeps each site's rows there for MeasureSiteSet. With
