@@ -37,12 +37,16 @@ double box_segment_distance(const OrientedBox& box, const Vec3& a, const Vec3& b
   };
   const double ratio = (std::sqrt(5.0) - 1) / 2;
   double lo = 0.0, hi = 1.0;
-  for (int i = 0; i < 60; ++i) {
-    const double m1 = hi - ratio * (hi - lo), m2 = lo + ratio * (hi - lo);
-    if (distance(m1) <= distance(m2))
-      hi = m2;
-    else
-      lo = m1;
+  double m1 = hi - ratio * (hi - lo), m2 = lo + ratio * (hi - lo);
+  double d1 = distance(m1), d2 = distance(m2);
+  for (int i = 0; i < 60; ++i) {  // each step keeps one probe and evaluates one new
+    if (d1 <= d2) {
+      hi = m2, m2 = m1, d2 = d1;
+      m1 = hi - ratio * (hi - lo), d1 = distance(m1);
+    } else {
+      lo = m1, m1 = m2, d1 = d2;
+      m2 = lo + ratio * (hi - lo), d2 = distance(m2);
+    }
   }
   return distance((lo + hi) / 2);
 }

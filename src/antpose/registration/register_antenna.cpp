@@ -163,15 +163,18 @@ bool passes_through_neighbour(const OrientedBox& box, const std::vector<Oriented
 //  - the best outline among the candidates centred in the rectangle but spanning too little of it,
 //    and its span: where it fits clearly and nothing that spans the rectangle does, the rectangle
 //    is drawn too loosely, not the photos unclear;
-//  - the candidates against the known mast whose outline fits at least faintly: where nothing
+//  - whether a candidate against the known mast fits its outline at least faintly: where nothing
 //    else fits, the outline found is the mast's and its clamps', not the panel's.
 struct Dropped {
   double small_score = 1.0, small_span = 0.0;
-  std::size_t against_mast = 0;
+  bool mast_fits = false;
   void too_small(double outline_score, double rectangle_span) {
     if (outline_score < small_score) small_score = outline_score, small_span = rectangle_span;
   }
 };
+
+// The rounding of a parametric panel's long edges; 0 for a mesh model.
+double edge_rounding(const model::AntennaModel& model) { return model.panel ? model.panel->edge_radius_m : 0.0; }
 
 // The gap between the panel, its box with the vertical edges rounded by `edge_radius_m`, and the
 // mast's surface over the mast's extent; negative where they overlap.
@@ -198,10 +201,8 @@ std::vector<Refined> distinct_in_rectangle(std::vector<Refined> refined, const m
       dropped.too_small(r.outline.score, fit.span);
     if (fit.span < o.min_roi_span || !fit.centred) continue;
     if (passes_through_neighbour({T, model.size_m}, s.neighbours_board, o.neighbour_clearance_m)) continue;
-    const double rounding = r.model->panel ? r.model->panel->edge_radius_m : 0.0;
-    if (s.mast && mast_gap({T, model.size_m}, rounding, *s.mast) < o.min_mast_gap_m) {
-      dropped.against_mast +=
-          r.outline.views_used >= o.min_outline_views && r.outline.score <= o.max_faint_outline_score;
+    if (s.mast && mast_gap({T, model.size_m}, edge_rounding(*r.model), *s.mast) < o.min_mast_gap_m) {
+      dropped.mast_fits |= r.outline.views_used >= o.min_outline_views && r.outline.score <= o.max_faint_outline_score;
       continue;
     }
     const auto known = std::find_if(out.begin(), out.end(), [&](const Refined& k) {
@@ -493,7 +494,7 @@ AntennaRegistration select(const AntennaScene& s, std::vector<Refined> kept, con
 // with the outline adds its pose as one the σ covers, and a warning.
 void check_faces(AntennaRegistration& out, const model::AntennaModel& model, const AntennaScene& s,
                  const RegisterOptions& o) {
-  const double radius = model.panel ? model.panel->edge_radius_m : 0.0;
+  const double radius = edge_rounding(model);
   out.face_planes = fit_face_planes(s.points_board, out.T_board_antenna, model.size_m, radius, s.viewpoints_board,
                                     out.rotation_covariance_board(), o.face_plane);
   for (const auto& plane : out.face_planes) {
@@ -577,7 +578,7 @@ Mat3 AntennaRegistration::rotation_covariance_board() const {
 }
 
 double mast_gap(const model::AntennaModel& model, const Iso3& T_board_antenna, const reconstruction::Mast& mast) {
-  return mast_gap({T_board_antenna, model.size_m}, model.panel ? model.panel->edge_radius_m : 0.0, mast);
+  return mast_gap({T_board_antenna, model.size_m}, edge_rounding(model), mast);
 }
 
 AntennaRegistration found_only_the_mast(const model::AntennaModel& model, std::size_t proposed) {
@@ -621,7 +622,7 @@ AntennaRegistration register_antenna(const model::AntennaModel& model, const Ant
                     "it fits more than faintly: is the rectangle drawn closely around the whole antenna?",
                     model.name, dropped.small_score, 100 * dropped.small_span, 100 * o.min_roi_span));
   }
-  if (kept.empty() && dropped.against_mast > 0) return found_only_the_mast(model, proposals.size());
+  if (kept.empty() && dropped.mast_fits) return found_only_the_mast(model, proposals.size());
   if (kept.empty()) {
     return not_found(
         proposals.size(),
