@@ -38,6 +38,8 @@ struct SceneSpec {
   double focal_px = 1050;
   std::vector<double> view_offsets_deg{-15.0, -10.0, -5.0, 0.0, 5.0, 10.0, 15.0};
   bool look_away = false;  // the cameras turned away from the antenna
+  /// Where not empty, rendered in place of the panel (antenna frame): a panel other than the model.
+  model::Mesh rendered;
 };
 
 // The board frame is an arbitrary rigid frame (T_world_board), as in a real capture.
@@ -59,7 +61,7 @@ inline SyntheticScene make_scene(const SceneSpec& spec = {}) {
   sim::Scene scene;
   sim::MeshObject antenna;
   antenna.name = "antenna";
-  antenna.mesh = panel.mesh_antenna;
+  antenna.mesh = spec.rendered.vertices.empty() ? panel.mesh_antenna : spec.rendered;
   antenna.corner_normals = sim::smooth_corner_normals(antenna.mesh, deg2rad(30));
   antenna.R_world_object = R_world_antenna;
   antenna.p_world_object = p_world_antenna;

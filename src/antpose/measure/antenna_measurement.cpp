@@ -138,7 +138,9 @@ void apply_registration(AntennaMeasurement& m, const model::AntennaModel& model,
   for (const auto& rival : r.rivals) m.rivals_board.push_back(rival.linear());
   for (const auto& rival : r.near_rivals) m.rivals_board.push_back(rival.linear());
   for (const auto& rival : r.face_rivals) m.face_rivals_board.push_back(rival.linear());
+  for (const auto& rival : r.edge_rivals) m.edge_rivals_board.push_back(rival.linear());
   m.face_planes = r.face_planes;
+  m.long_edges_left_out = r.long_edges_left_out;
   m.verdict = r.verdict;
   m.runner_up = r.selection.runner_up;
   if (r.selection.mast_rival) m.mast_rival = r.selection.versus_mast_rival;
@@ -384,6 +386,8 @@ void measure_antenna(AntennaMeasurement& m, const model::AntennaModel* model, co
   if (!m.rivals_board.empty()) widen_for_rivals(m.attitude, m.R_board_antenna, m.rivals_board, *c.board);
   if (!m.face_rivals_board.empty())
     widen_for_rivals(m.attitude, m.R_board_antenna, m.face_rivals_board, *c.board, "face points against the outline");
+  if (!m.edge_rivals_board.empty())
+    widen_for_rivals(m.attitude, m.R_board_antenna, m.edge_rivals_board, *c.board, "one long edge against the rest");
   if (auto w = imprecision_warning(m.attitude, o)) m.warnings.push_back(std::move(*w));
 }
 

@@ -114,8 +114,15 @@ nlohmann::json antenna_json(const AntennaMeasurement& m) {
                      {"turn_deg", rad2deg(f.turn_board.norm())},
                      {"chi2", f.chi2},
                      {"disagrees", f.disagrees}});
+  nlohmann::json long_edges = nlohmann::json::array();
+  for (const auto& e : m.long_edges_left_out)
+    long_edges.push_back({{"edge", registration::long_edge_name(e.edge)},
+                          {"turn_deg", rad2deg(e.turn_rad)},
+                          {"distance", e.distance},
+                          {"disagrees", e.disagrees}});
   a["registration"] = {{"candidates", m.candidates},
                        {"face_planes", faces},
+                       {"long_edges_left_out", long_edges},
                        {"poses", poses},
                        {"rivals", m.rivals_board.size()},
                        {"runner_up", comparison_json(m.runner_up)},

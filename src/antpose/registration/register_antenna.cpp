@@ -511,6 +511,26 @@ void check_faces(AntennaRegistration& out, const model::AntennaModel& model, con
   }
 }
 
+// The result against each of its long edges left out (long_edge_check.hpp): each edge that decides
+// the pose against the others adds the pose without it as one the σ covers, and a warning.
+void judge_long_edges(AntennaRegistration& out, const model::AntennaModel& model, const AntennaScene& s,
+                      const RegisterOptions& o) {
+  auto polish = polish_of(o.refine);
+  polish.outline_box_m = model::outline_box(model);
+  out.long_edges_left_out = check_long_edges(model.mesh_antenna, out.T_board_antenna, s.views, s.intrinsics, polish,
+                                             out.rotation_covariance_board(), o.long_edges);
+  for (const auto& e : out.long_edges_left_out) {
+    if (!e.disagrees) continue;
+    out.edge_rivals.push_back(e.T_board_antenna);
+    out.warnings.push_back(fmt::format(
+        "the pose rests on the outline of the panel's {} long edge: without it the other edges put the panel {:.1f}° "
+        "turned ({:.1f} σ); a rounded edge before a background of about its own brightness shows its shading, not "
+        "its outline, and the σ covers both; photos with that edge against a contrasting background (from another "
+        "side, or in other light) would settle it",
+        long_edge_name(e.edge), rad2deg(e.turn_rad), e.distance));
+  }
+}
+
 // "Not found", and why.
 AntennaRegistration not_found(std::size_t proposed, std::string why) {
   AntennaRegistration none;
@@ -551,6 +571,7 @@ OptionProblems RegisterOptions::Check() const {
   p.nest("panel_shape", panel_shape.Check());
   p.nest("mount_search", mount_search.Check());
   p.nest("face_plane", face_plane.Check());
+  p.nest("long_edges", long_edges.Check());
   p.require(refine_candidates >= 1, "refine_candidates", "at least 1");
   p.require(same_pose_deg >= 0 && same_pose_m >= 0, "same_pose_deg, same_pose_m", "≥ 0");
   p.require(neighbour_clearance_m >= 0, "neighbour_clearance_m", "≥ 0");
@@ -638,6 +659,7 @@ AntennaRegistration register_antenna(const model::AntennaModel& model, const Ant
   auto out = select(s, std::move(kept), o);
   out.proposed = proposals.size();
   check_faces(out, out.panel_shape ? out.panel_shape->model : model, s, o);
+  judge_long_edges(out, out.panel_shape ? out.panel_shape->model : model, s, o);
   if (out.outline_score > o.max_outline_score)
     out.warnings.push_back(fmt::format(
         "the model's outline meets the photos' edges only faintly (score {:.2f}; a clearly seen antenna scores "

@@ -26,7 +26,8 @@
 // min_outline_views). Among those, only the comparison with the best (pose_selection.hpp) rules a
 // candidate out: a fixed score cut would drop the true pose wherever the edges are faint or
 // cluttered and a wrong pose meets other edges a little better, leaving that wrong pose unique.
-// The result's faces are then checked against the region's points (face_plane.hpp). "Not found"
+// The result's faces are then checked against the region's points (face_plane.hpp), and the pose
+// against each of its long edges left out (long_edge_check.hpp). "Not found"
 // is a value: the result says why and what photo or rectangle would help; a pose that fits clearly
 // but spans too little of a rectangle in which nothing else fits more than faintly says the
 // rectangle is drawn too loosely, and poses that fit only against the mast say the mast was found.
@@ -46,6 +47,7 @@
 #include "antpose/registration/axis_slide.hpp"
 #include "antpose/registration/face_plane.hpp"
 #include "antpose/registration/global_start.hpp"
+#include "antpose/registration/long_edge_check.hpp"
 #include "antpose/registration/outline_search.hpp"
 #include "antpose/registration/pose_evidence.hpp"
 #include "antpose/registration/pose_selection.hpp"
@@ -105,6 +107,7 @@ struct RegisterOptions {
   ShapeOptions panel_shape;                        // the best candidates' shape profiled (shape_fit.hpp)
   reconstruction::MastSearchOptions mount_search;  // vertical structure behind and before the best
   FacePlaneOptions face_plane;                     // the result's faces checked against its points (face_plane.hpp)
+  LongEdgeCheckOptions long_edges;                 // the result against each long edge left out (long_edge_check.hpp)
   std::size_t shape_candidates = 3;                // that many, by their outline
   double same_pose_deg = 2.0, same_pose_m = 0.03;  // refined candidates this close are one
   double min_roi_span = 0.55;                      // outline_search.hpp's rectangle_fit
@@ -150,6 +153,10 @@ struct AntennaRegistration {
   /// that disagrees with the outline: the σ covers those too.
   std::vector<FacePlane> face_planes;
   std::vector<Iso3> face_rivals;
+  /// The result refined with each long edge left out (long_edge_check.hpp), and of those the poses
+  /// that disagree with it: one edge decides the pose against the others, and the σ covers both.
+  std::vector<LongEdgeLeftOut> long_edges_left_out;
+  std::vector<Iso3> edge_rivals;
   Selection selection;
   std::vector<PoseCandidate> candidates;  // refined, distinct, with their evidence
   std::size_t proposed = 0;               // candidates the strategies proposed

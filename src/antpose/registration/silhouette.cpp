@@ -527,4 +527,11 @@ OutlineEvaluation evaluate_outline(const model::Mesh& mesh_antenna, const Iso3& 
   return evaluate_outlines(mesh_antenna, {T_board_antenna}, views, intrinsics, options).front();
 }
 
+std::optional<int> long_edge_of(const Vec3& a_antenna, const Vec3& b_antenna) {
+  const Vec3 d = b_antenna - a_antenna;
+  if (!(std::abs(d.z()) >= 0.9 * d.norm()) || d.norm() == 0) return std::nullopt;
+  const Vec3 middle = 0.5 * (a_antenna + b_antenna);
+  return static_cast<int>(middle.x() > 0) + 2 * static_cast<int>(middle.y() > 0);
+}
+
 }  // namespace antpose::registration

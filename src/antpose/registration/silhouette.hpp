@@ -137,6 +137,9 @@ struct SilhouetteOptions {
   // They still hide what lies behind them. Zero: every outline point is measured.
   Vec3 outline_box_m = Vec3::Zero();
   double box_tolerance_m = 0.002;
+  // The model's four long edges (along z_a), by long_edge_of's index: outline points on one set
+  // false are not measured, as if it had no outline (long_edge_check.hpp leaves each out in turn).
+  std::array<bool, 4> long_edges{true, true, true, true};
   std::array<bool, 6> free{true, true, true, true, true, true};  // rotation δ x, y, z (board), translation x, y, z
   // Rivals: descents from the solution turned by these angles about the long axis (file comment).
   std::vector<double> rival_yaw_offsets_rad{deg2rad(-30.0), deg2rad(30.0)};  // empty: none
@@ -246,6 +249,12 @@ struct OutlineEvaluation {
 OutlineEvaluation evaluate_outline(const model::Mesh& mesh_antenna, const Iso3& T_board_antenna,
                                    const std::vector<SilhouetteView>& views, const camera::CameraIntrinsics& intrinsics,
                                    const SilhouetteOptions& options);
+
+/// The long edge of a panel (SilhouetteOptions::long_edges) that the mesh edge from `a_antenna` to
+/// `b_antenna` lies on: where it runs along z_a, the quadrant of its middle, (x_a > 0) + 2 (y_a > 0);
+/// else none. A convex panel's outline runs along its long sides only on these four edges (a
+/// rounded one's on the rounding's facets), whatever the view.
+std::optional<int> long_edge_of(const Vec3& a_antenna, const Vec3& b_antenna);
 
 /// evaluate_outline at each of `poses`, which lie close together (a line search's): the photos are
 /// prepared once, cropped around all of them.

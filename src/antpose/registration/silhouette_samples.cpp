@@ -173,6 +173,7 @@ void gather(const EdgeMesh& m, const Pose& pose, const PreparedView& v, const ca
     if (!silhouette) continue;
     const Vec3& a_antenna = m.vertices[e.a];
     const Vec3& b_antenna = m.vertices[e.b];
+    if (const auto long_edge = long_edge_of(a_antenna, b_antenna); long_edge && !o.long_edges[*long_edge]) continue;
     const int n = static_cast<int>(std::floor((*pm.uv[e.b] - *pm.uv[e.a]).norm() / spacing));
     const Vec3 A = pose.R * a_antenna + pose.t, B = pose.R * b_antenna + pose.t;
     for (int j = 0; j < n; ++j) {
