@@ -17,28 +17,38 @@ OptionProblems LongEdgeCheckOptions::Check() const {
   return p;
 }
 
+namespace {
+
+// √(δᵀ (Σ_without + Σ_whole + floor² I)⁻¹ δ) (the header's comment).
+double distance(const Vec3& turn, const Mat3& without, const Mat3& whole, double floor) {
+  const Mat3 covariance = without + whole + floor * floor * Mat3::Identity();
+  return std::sqrt(std::max(0.0, turn.dot(covariance.ldlt().solve(turn))));
+}
+
+}  // namespace
+
 std::vector<LongEdgeLeftOut> check_long_edges(const model::Mesh& mesh_antenna, const Iso3& T_board_antenna,
                                               const std::vector<SilhouetteView>& views,
                                               const camera::CameraIntrinsics& intrinsics,
-                                              const SilhouetteOptions& polish, const Mat3& rotation_covariance_board,
-                                              const LongEdgeCheckOptions& options) {
+                                              const SilhouetteOptions& polish, const LongEdgeCheckOptions& options) {
   throw_unless_ok(options.Check(), "LongEdgeCheckOptions");
   std::vector<LongEdgeLeftOut> out;
   if (!options.enabled) return out;
-  const Mat3 covariance =
-      rotation_covariance_board + options.sigma_floor_rad * options.sigma_floor_rad * Mat3::Identity();
-  const Eigen::LDLT<Mat3> inverse(covariance);
+  const auto whole = refine_by_silhouette(mesh_antenna, T_board_antenna, views, intrinsics, polish);
+  if (whole.views_used < options.min_views) return out;
+  const Mat3 R_whole = whole.T_board_antenna.linear();
   for (int edge = 0; edge < 4; ++edge) {
     auto without = polish;
     without.long_edges[static_cast<std::size_t>(edge)] = false;
-    const auto refined = refine_by_silhouette(mesh_antenna, T_board_antenna, views, intrinsics, without);
+    const auto refined = refine_by_silhouette(mesh_antenna, whole.T_board_antenna, views, intrinsics, without);
     if (refined.views_used < options.min_views) continue;
     LongEdgeLeftOut& e = out.emplace_back();
     e.edge = edge;
     e.T_board_antenna = refined.T_board_antenna;
-    const Vec3 turn = log_so3(refined.T_board_antenna.linear() * T_board_antenna.linear().transpose());
+    const Vec3 turn = log_so3(refined.T_board_antenna.linear() * R_whole.transpose());
     e.turn_rad = turn.norm();
-    e.distance = std::sqrt(std::max(0.0, turn.dot(inverse.solve(turn))));
+    e.distance = distance(turn, refined.covariance.topLeftCorner<3, 3>(), whole.covariance.topLeftCorner<3, 3>(),
+                          options.sigma_floor_rad);
     e.disagrees = e.distance > options.max_distance;
   }
   return out;

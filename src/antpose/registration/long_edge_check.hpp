@@ -2,18 +2,24 @@
 //
 // Near its outline a rounded radome edge is seen at grazing incidence. Where the rounding's shading
 // matches the background's brightness over part of it (a white radome before a bright sky, a low
-// sun), the edge found there is the shading's, inside the outline by up to the rounding's
-// projected radius: on 62 px wide panels, 1–3 px along a whole long edge. The sun makes it much
-// the same in every photo, so it does not average out, and nothing in that edge's samples tells a
-// shading edge from an outline: the pose takes it up (a turn about the long axis, the rounding
-// profiled with it, shape_fit.hpp), the residuals stay small and the σ, built on them, narrow.
+// sun), the edge found there is the shading's, inside the outline by up to the rounding's projected
+// radius (a few pixels where the panel is some tens of pixels wide), along the whole long edge.
+// The sun makes it much the same in every photo, so it does not average out, and nothing in that
+// edge's samples tells a shading edge from an outline: the pose takes it up (a turn about the long
+// axis, the rounding profiled with it, shape_fit.hpp), the residuals stay small and the σ, built
+// on them, narrow.
 // The other edges tell. Refined with one long edge left out (SilhouetteOptions::long_edges), the
-// pose agrees with the whole outline's within its covariance where every edge is an outline; where
-// it does not, that one edge decides the pose against all the others, and the pose without it is
-// one the σ must cover. This is a leave-one-group-out jackknife over the outline's independent
-// parts (Efron & Tibshirani, An Introduction to the Bootstrap, 1993, ch. 11), used as a test:
-// only an edge that moves the pose beyond its own σ adds a pose, so a sound outline's σ is not
-// counted twice.
+// pose agrees with the whole outline's where every edge is an outline; where it does not, that one
+// edge decides the pose against all the others, and the pose without it is one the σ must cover.
+// Agreement: where every edge is sound, the whole outline's pose is the efficient one and the pose
+// without an edge a consistent one, so their difference δ has the covariance Σ_without − Σ_whole
+// (Hausman, Econometrica 46(6), 1978). That difference of two estimated covariances is too
+// fragile to divide by: the outline's covariance is itself estimated from its residuals, and the
+// arms, brackets and clamps a model lacks make sound edges differ by about their own σ. So δ is
+// measured against the bound Σ_without + Σ_whole (the two as if independent) and an edge taken for
+// a wrong one only where its absence moves the pose well beyond both σ: a sound outline's σ is not
+// counted twice, nor is an edge whose absence only leaves the pose loosely held (one long edge left
+// in view) taken for a wrong one.
 #pragma once
 
 #include <cstddef>
@@ -29,10 +35,10 @@ namespace antpose::registration {
 struct LongEdgeCheckOptions {
   bool enabled = true;
   /// A pose without one long edge whose rotation lies further than this from the whole outline's
-  /// (Mahalanobis distance under the whole outline's rotation covariance, 3 degrees of freedom:
-  /// 3 is beyond the 97th percentile) disagrees with it.
+  /// (the distance of the file comment, √χ² with three degrees of freedom: 3 is beyond its 97th
+  /// percentile) disagrees with it.
   double max_distance = 3.0;
-  /// The covariance's floor on each axis (rad): turns of a few hundredths of a degree are no
+  /// This σ on each axis (rad) is added to the bound: turns of a few hundredths of a degree are no
   /// disagreement whatever σ the outline claims.
   double sigma_floor_rad = deg2rad(0.05);
   std::size_t min_views = 3;  // a pose without the edge refined in fewer photos says nothing
@@ -43,19 +49,18 @@ struct LongEdgeLeftOut {
   int edge = 0;                             // long_edge_of's index
   Iso3 T_board_antenna = Iso3::Identity();  // the pose refined without it
   double turn_rad = 0.0;                    // its rotation from the whole outline's pose
-  double distance = 0.0;                    // that rotation's Mahalanobis distance
+  double distance = 0.0;                    // the distance of the file comment
   bool disagrees = false;                   // beyond max_distance
 };
 
-/// The pose `T_board_antenna` of `mesh_antenna` refined with `polish` (its outline_box_m set) with
-/// each long edge left out in turn, judged against `rotation_covariance_board` (rad², board frame:
-/// the whole outline's). Long edges without which fewer than min_views photos hold the outline
-/// are not listed. Views and intrinsics as refine_by_silhouette.
+/// The pose `T_board_antenna` of `mesh_antenna` refined with `polish` (its outline_box_m set), whole
+/// and with each long edge left out in turn, the two compared (file comment). Long edges
+/// without which fewer than min_views photos hold the outline are not listed. Views and
+/// intrinsics as refine_by_silhouette.
 std::vector<LongEdgeLeftOut> check_long_edges(const model::Mesh& mesh_antenna, const Iso3& T_board_antenna,
                                               const std::vector<SilhouetteView>& views,
                                               const camera::CameraIntrinsics& intrinsics,
-                                              const SilhouetteOptions& polish, const Mat3& rotation_covariance_board,
-                                              const LongEdgeCheckOptions& options);
+                                              const SilhouetteOptions& polish, const LongEdgeCheckOptions& options);
 
 /// "+x+y" and so on: the faces, in the antenna frame, that meet at long edge `edge`.
 std::string long_edge_name(int edge);

@@ -517,8 +517,8 @@ void judge_long_edges(AntennaRegistration& out, const model::AntennaModel& model
                       const RegisterOptions& o) {
   auto polish = polish_of(o.refine);
   polish.outline_box_m = model::outline_box(model);
-  out.long_edges_left_out = check_long_edges(model.mesh_antenna, out.T_board_antenna, s.views, s.intrinsics, polish,
-                                             out.rotation_covariance_board(), o.long_edges);
+  out.long_edges_left_out =
+      check_long_edges(model.mesh_antenna, out.T_board_antenna, s.views, s.intrinsics, polish, o.long_edges);
   for (const auto& e : out.long_edges_left_out) {
     if (!e.disagrees) continue;
     out.edge_rivals.push_back(e.T_board_antenna);
