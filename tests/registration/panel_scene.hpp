@@ -39,7 +39,7 @@ struct SceneSpec {
   std::vector<double> view_offsets_deg{-15.0, -10.0, -5.0, 0.0, 5.0, 10.0, 15.0};
   bool look_away = false;  // the cameras turned away from the antenna
   /// Where not empty, rendered in place of the panel (antenna frame): a panel other than the model.
-  model::Mesh rendered;
+  model::Mesh rendered{};
 };
 
 // The board frame is an arbitrary rigid frame (T_world_board), as in a real capture.
