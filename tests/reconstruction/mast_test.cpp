@@ -138,6 +138,34 @@ TEST(Mast, IsNotClaimedWithoutItsOutline) {
   EXPECT_FALSE(fit_mast(seen_points(s, 4), up, s.views, s.K, ground + 15.6, ground + 14.0, {}));
 }
 
+// A fatter cylinder sharing one of the mast's outline lines (its axis moved sideways by as much as
+// its radius grew) meets edges along that line in every photo and along the other in none: at the
+// share the outline search asks of the two together it would pass, but one line fixes no
+// cylinder, so it is not confirmed; the mast itself, from the same share, is.
+TEST(Mast, IsNotConfirmedByOneOutlineLine) {
+  const auto& s = mast_scene();
+  const Vec3 up = s.up_board();
+  const Vec3 axis_board = s.board(s.axis_world);
+  const double ground = up.dot(axis_board);
+  const Vec3 centre = camera::camera_centre(s.views[4].R_camera_board, s.views[4].t_camera_board);
+  const Vec3 towards = (centre - axis_board - (centre - axis_board).dot(up) * up).normalized();
+  const Vec3 across = up.cross(towards);
+  MastOptions o;
+  o.min_edge_fraction = 0.4;
+  Mast mast;
+  mast.up_board = up;
+  mast.axis_point_board = axis_board + (ground + 14.0 - up.dot(axis_board)) * up;
+  mast.radius_m = s.radius;
+  mast.low_m = -1.0, mast.high_m = 2.0;
+  const auto found = confirm_mast(mast, s.views, s.K, ground + 14.0, ground + 15.6, {}, o);
+  ASSERT_TRUE(found.has_value());
+  EXPECT_NEAR(found->radius_m, s.radius, 0.005);
+  Mast fat = mast;
+  fat.radius_m = s.radius + 0.3;
+  fat.axis_point_board += 0.3 * across;
+  EXPECT_FALSE(confirm_mast(fat, s.views, s.K, ground + 14.0, ground + 15.6, {}, o));
+}
+
 // Stage 1 alone claims the cylinder the points lie on whatever the photos show, and says no photo
 // confirmed it; too few points or too short a stretch: none.
 TEST(Mast, FromPointsAloneIsTheCylinderTheyLieOn) {

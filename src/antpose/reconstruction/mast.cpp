@@ -109,6 +109,7 @@ struct Tangency {
   Vec3 centre_board, ray_board;
   double px_per_m = 0.0;  // image scale at the mast's distance
   std::size_t view = 0;
+  int side = 0;  // which of the photo's two outline lines (tangent_points' order), where confirming
 };
 
 struct TangentResidual {
@@ -270,12 +271,13 @@ std::optional<PhotoEstimate> edges_across(EdgeView& ev, std::size_t index, const
 }
 
 // Stage 2b: both outline lines of the cylinder p = (axis x, y, radius) sampled in every photo,
-// the nearest edge within ±search_px of each sample; returns how many samples were taken.
-std::size_t outline_tangencies(const std::vector<EdgeView>& edge_views, const Horizontal& h, const double* p,
-                               double z_low, double z_high, double search_px, const camera::CameraIntrinsics& K,
-                               const MastOptions& o, std::vector<Tangency>& found) {
+// the nearest edge within ±search_px of each sample; returns how many samples were taken on each.
+using SideCounts = std::array<std::size_t, 2>;
+SideCounts outline_tangencies(const std::vector<EdgeView>& edge_views, const Horizontal& h, const double* p,
+                              double z_low, double z_high, double search_px, const camera::CameraIntrinsics& K,
+                              const MastOptions& o, std::vector<Tangency>& found) {
   found.clear();
-  std::size_t sampled = 0;
+  SideCounts sampled{};
   std::vector<double> scratch;
   const Vec2 axis(p[0], p[1]);
   for (std::size_t vi = 0; vi < edge_views.size(); ++vi) {
@@ -283,7 +285,8 @@ std::size_t outline_tangencies(const std::vector<EdgeView>& edge_views, const Ho
     const auto t = tangent_points(h, axis, p[2], ev.centre_board);
     if (!t) continue;
     const double px_per_m = 0.5 * (K.fx + K.fy) / (h.of(ev.centre_board) - axis).norm();
-    for (const auto& tp : *t) {
+    for (int side = 0; side < 2; ++side) {
+      const Vec2& tp = (*t)[static_cast<std::size_t>(side)];
       const auto a = project(K, *ev.view, h.point(tp, z_low)), b = project(K, *ev.view, h.point(tp, z_high));
       if (!a || !b) continue;
       const int n = std::max(2, static_cast<int>((*b - *a).norm() / o.sample_spacing_px));
@@ -295,13 +298,13 @@ std::size_t outline_tangencies(const std::vector<EdgeView>& edge_views, const Ho
         if (in_crop.x() < 0 || in_crop.y() < 0 || in_crop.x() > ev.gx.cols - 1 || in_crop.y() > ev.gx.rows - 1 ||
             ev.hides(in_crop))
           continue;
-        ++sampled;
+        ++sampled[static_cast<std::size_t>(side)];
         const auto edge =
             camera::nearest_edge(ev.gx, ev.gy, q - ev.offset, normal, camera::EdgeSearchSpan::symmetric(search_px),
                                  o.min_edge_gradient, scratch);
         if (edge)
           found.push_back(
-              {ev.centre_board, ev.view->R_camera_board.transpose() * K.ray(q + *edge * normal), px_per_m, vi});
+              {ev.centre_board, ev.view->R_camera_board.transpose() * K.ray(q + *edge * normal), px_per_m, vi, side});
       }
     }
   }
@@ -420,7 +423,7 @@ std::optional<Mast> confirm_mast(const Mast& start, const std::vector<PosedView>
   }
   // Every outline sample, the nearest edge within a shrinking range.
   std::vector<Tangency> found;
-  std::size_t sampled = 0;
+  SideCounts sampled{};
   for (const double search : o.search_px) {
     sampled = outline_tangencies(edge_views, h, p, z_low, z_high, search, K, o, found);
     if (found.size() < 3) return std::nullopt;
@@ -429,20 +432,27 @@ std::optional<Mast> confirm_mast(const Mast& start, const std::vector<PosedView>
   // Confirmation by the last round's samples.
   std::vector<std::size_t> per_view(edge_views.size(), 0);
   double ss = 0.0;
-  std::size_t inliers = 0;
+  SideCounts inliers{};
   for (const auto& t : found) {
     double r = 0.0;
     TangentResidual{t.centre_board, t.ray_board, h.e1, h.e2, h.up, t.px_per_m}(p, &r);
     if (std::abs(r) > 2.0 * o.loss_px) continue;
-    ss += r * r, ++inliers, ++per_view[t.view];
+    ss += r * r, ++inliers[static_cast<std::size_t>(t.side)], ++per_view[t.view];
   }
   Mast mast = start;
   mast.axis_point_board = h.point(Vec2(p[0], p[1]), h.up.dot(start.axis_point_board));
   mast.radius_m = p[2];
   mast.views = static_cast<std::size_t>(std::count_if(per_view.begin(), per_view.end(), [](auto n) { return n >= 5; }));
-  mast.edge_samples = inliers;
-  mast.edge_rms_px = inliers ? std::sqrt(ss / static_cast<double>(inliers)) : 0.0;
-  if (mast.views < o.min_views || static_cast<double>(inliers) < o.min_edge_fraction * static_cast<double>(sampled) ||
+  mast.edge_samples = inliers[0] + inliers[1];
+  mast.edge_rms_px = mast.edge_samples ? std::sqrt(ss / static_cast<double>(mast.edge_samples)) : 0.0;
+  // Both lines, each at half the share asked of the two: one line alone is tangent to a whole
+  // family of cylinders (the radius traded against the axis' offset), so it fixes none of them.
+  const auto share = [&](std::size_t side, double fraction) {
+    return static_cast<double>(inliers[side]) >= fraction * static_cast<double>(sampled[side]);
+  };
+  const bool both_lines = share(0, 0.5 * o.min_edge_fraction) && share(1, 0.5 * o.min_edge_fraction);
+  if (mast.views < o.min_views || !both_lines ||
+      static_cast<double>(mast.edge_samples) < o.min_edge_fraction * static_cast<double>(sampled[0] + sampled[1]) ||
       mast.edge_rms_px > o.max_rms_px)
     return std::nullopt;
   return mast;

@@ -63,7 +63,7 @@ struct MastOptions {
   double min_edge_gradient = 3.0;
   double loss_px = 1.0;  // Cauchy scale
   std::size_t min_views = 3;
-  double min_edge_fraction = 0.7;  // of the samples, on an edge within 2 loss scales
+  double min_edge_fraction = 0.7;  // of the samples on an edge within 2 loss scales; of each line, half that
   double max_rms_px = 1.5;
 };
 
