@@ -138,7 +138,6 @@ void apply_registration(AntennaMeasurement& m, const model::AntennaModel& model,
   for (const auto& rival : r.rivals) m.rivals_board.push_back(rival.linear());
   for (const auto& rival : r.near_rivals) m.rivals_board.push_back(rival.linear());
   for (const auto& rival : r.face_rivals) m.face_rivals_board.push_back(rival.linear());
-  for (const auto& rival : r.edge_rivals) m.edge_rivals_board.push_back(rival.linear());
   m.face_planes = r.face_planes;
   m.long_edges_left_out = r.long_edges_left_out;
   m.verdict = r.verdict;
@@ -386,8 +385,11 @@ void measure_antenna(AntennaMeasurement& m, const model::AntennaModel* model, co
   if (!m.rivals_board.empty()) widen_for_rivals(m.attitude, m.R_board_antenna, m.rivals_board, *c.board);
   if (!m.face_rivals_board.empty())
     widen_for_rivals(m.attitude, m.R_board_antenna, m.face_rivals_board, *c.board, "face points against the outline");
-  if (!m.edge_rivals_board.empty())
-    widen_for_rivals(m.attitude, m.R_board_antenna, m.edge_rivals_board, *c.board, "one long edge against the rest");
+  std::vector<Mat3> edge_rivals_board;  // the result without a long edge that decides it against the others
+  for (const auto& e : m.long_edges_left_out)
+    if (e.disagrees) edge_rivals_board.push_back(e.T_board_antenna.linear());
+  if (!edge_rivals_board.empty())
+    widen_for_rivals(m.attitude, m.R_board_antenna, edge_rivals_board, *c.board, "one long edge against the rest");
   if (auto w = imprecision_warning(m.attitude, o)) m.warnings.push_back(std::move(*w));
 }
 

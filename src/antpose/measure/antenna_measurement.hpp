@@ -85,7 +85,6 @@ struct AntennaMeasurement {
   std::vector<Mat3> face_rivals_board;       // the result laid on its faces' points where they disagree with it
   std::vector<registration::FacePlane> face_planes;  // the faces' planes (registration/face_plane.hpp)
   std::vector<registration::LongEdgeLeftOut> long_edges_left_out;  // registration/long_edge_check.hpp
-  std::vector<Mat3> edge_rivals_board;  // the result without a long edge that decides it against the others
   registration::RegistrationVerdict verdict = registration::RegistrationVerdict::kUnique;
   std::optional<registration::Comparison> runner_up;  // the result against the best other pose
   /// Where the result turns a side face to the mast: it against the best pose that faces the mast.

@@ -512,7 +512,7 @@ void check_faces(AntennaRegistration& out, const model::AntennaModel& model, con
 }
 
 // The result against each of its long edges left out (long_edge_check.hpp): each edge that decides
-// the pose against the others adds the pose without it as one the σ covers, and a warning.
+// the pose against the others adds a warning (the measurement's σ covers the pose without it).
 void judge_long_edges(AntennaRegistration& out, const model::AntennaModel& model, const AntennaScene& s,
                       const RegisterOptions& o) {
   auto polish = polish_of(o.refine);
@@ -521,7 +521,6 @@ void judge_long_edges(AntennaRegistration& out, const model::AntennaModel& model
       check_long_edges(model.mesh_antenna, out.T_board_antenna, s.views, s.intrinsics, polish, o.long_edges);
   for (const auto& e : out.long_edges_left_out) {
     if (!e.disagrees) continue;
-    out.edge_rivals.push_back(e.T_board_antenna);
     out.warnings.push_back(fmt::format(
         "the pose rests on the outline of the panel's {} long edge: without it the other edges put the panel {:.1f}° "
         "turned ({:.1f} σ); a rounded edge before a background of about its own brightness shows its shading, not "

@@ -153,10 +153,9 @@ struct AntennaRegistration {
   /// that disagrees with the outline: the σ covers those too.
   std::vector<FacePlane> face_planes;
   std::vector<Iso3> face_rivals;
-  /// The result refined with each long edge left out (long_edge_check.hpp), and of those the poses
-  /// that disagree with it: one edge decides the pose against the others, and the σ covers both.
+  /// The result refined with each long edge left out (long_edge_check.hpp); where one disagrees
+  /// with it, that edge decides the pose against the others, and the σ covers both.
   std::vector<LongEdgeLeftOut> long_edges_left_out;
-  std::vector<Iso3> edge_rivals;
   Selection selection;
   std::vector<PoseCandidate> candidates;  // refined, distinct, with their evidence
   std::size_t proposed = 0;               // candidates the strategies proposed
