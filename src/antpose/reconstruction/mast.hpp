@@ -18,7 +18,8 @@
 //     distance from the axis equals the radius. The axis (2 parameters) and the radius are fitted
 //     to these tangencies with Ceres (Cauchy loss, residuals in pixels), in rounds with a
 //     shrinking search range, the first as wide as stage 1's uncertainty. A cylinder that its
-//     outline does not confirm (too few views or samples on an edge, a large RMS) is not a mast.
+//     outline does not confirm (too few views or samples on an edge, either line without its
+//     share of them, a large RMS) is not a mast.
 // The axis is the board frame's up (the board's attitude from gravity: masts stand within a
 // fraction of a degree of vertical).
 #pragma once
