@@ -37,10 +37,13 @@ std::vector<LongEdgeLeftOut> check_long_edges(const model::Mesh& mesh_antenna, c
   const auto whole = refine_by_silhouette(mesh_antenna, T_board_antenna, views, intrinsics, polish);
   if (whole.views_used < options.min_views) return out;
   const Mat3 R_whole = whole.T_board_antenna.linear();
+  // The four from one start: the photos are prepared once (refine_by_silhouette_runs); which long
+  // edge is left out only changes the samples gathered.
+  std::vector<SilhouetteOptions> runs(4, polish);
+  for (std::size_t edge = 0; edge < runs.size(); ++edge) runs[edge].long_edges[edge] = false;
+  const auto without = refine_by_silhouette_runs(mesh_antenna, whole.T_board_antenna, views, intrinsics, runs);
   for (int edge = 0; edge < 4; ++edge) {
-    auto without = polish;
-    without.long_edges[static_cast<std::size_t>(edge)] = false;
-    const auto refined = refine_by_silhouette(mesh_antenna, whole.T_board_antenna, views, intrinsics, without);
+    const SilhouetteResult& refined = without[static_cast<std::size_t>(edge)];
     if (refined.views_used < options.min_views) continue;
     LongEdgeLeftOut& e = out.emplace_back();
     e.edge = edge;
