@@ -93,10 +93,11 @@ std::vector<Site> everyday_sites() {
     sites.push_back(set_site(7001 + k, k, "wide"));
     if (k == 1) sites.back().warns = "the radome shows little texture, so the angles rest on its outline";
   }
-  // A grey radome before a grey sky, its points all on the mount pipe and clamps: every pose that
-  // fits an outline hangs on the pipe, and the answer must say so rather than give the pipe's tilt.
+  // A grey radome before a grey sky, its points all on the mount pipe and clamps: the poses that
+  // fit an outline lie on the pipe and meet little of their own, and the answer must say so rather
+  // than give the pipe's tilt.
   sites.push_back(set_site(18701, 0, "wide"));
-  sites.back().refuses = "hangs against or through the mast found behind it";
+  sites.back().refuses = "meets the photos' edges along little of its outline";
   // Classic regression sites, each measuring the antenna its fault was found on.
   const auto classic = [](int seed, bool ground, bool disturbance, int antennas, int only, std::string warns = {}) {
     Site s;
@@ -107,7 +108,10 @@ std::vector<Site> everyday_sites() {
   };
   sites.push_back(classic(3406, true, true, 3, 3));
   sites.push_back(classic(3711, false, false, 3, 2));
+  // Measured without its neighbours, a nearer panel crosses this one's rectangle and hides most
+  // of its outline: no answer, rather than the neighbour's edges taken for its own.
   sites.push_back(classic(5111, false, false, 3, 3));
+  sites.back().regression = false, sites.back().refuses = "meets the photos' edges along little of its outline";
   sites.push_back(classic(5810, true, false, 2, 1));
   // The rest of the regression sites, each also guarded by a shorter test or an everyday site that
   // takes the same path.

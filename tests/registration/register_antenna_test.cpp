@@ -159,7 +159,7 @@ TEST(RegisterAntenna, AStartInAMirrorYawsBasinIsTurnedToThePanel) {
 
 // Held where a faint side face would leave it, turned by atan(d / w) with its diagonal along the
 // panel's front face (yaw_turns.hpp), the registration places that pose's crease twin on the panel;
-// the panel's own outline, all four long edges seen here, then wins. Without the twins it stays.
+// the panel's own outline, all four long edges seen here, then wins.
 TEST(RegisterAntenna, APoseLyingOnTheCreaseHasThePanelAsItsTwin) {
   const SyntheticScene s = make_scene();
   const AntennaScene scene = antenna_scene(s);
@@ -184,10 +184,13 @@ TEST(RegisterAntenna, APoseLyingOnTheCreaseHasThePanelAsItsTwin) {
   EXPECT_LT(rad2deg(box_angle(r.T_board_antenna.linear(), s.T_board_antenna.linear())), 0.5);
   EXPECT_GT(r.rotation_covariance_board().trace(), 0.0) << "the twin's rotation is measured, not held";
 
+  // Without the twins only the pose on the crease is left, and it meets too little of its outline
+  // to be an answer.
   o.crease_twins = false;
   const auto without = register_antenna(model, scene, o, start);
-  ASSERT_TRUE(without.found) << without.why_not;
-  EXPECT_GT(rad2deg(box_angle(without.T_board_antenna.linear(), s.T_board_antenna.linear())), 10.0);
+  EXPECT_FALSE(without.found) << rad2deg(box_angle(without.T_board_antenna.linear(), s.T_board_antenna.linear()))
+                              << "° from the panel";
+  EXPECT_NE(without.why_not.find("along little of its outline"), std::string::npos) << without.why_not;
 }
 
 // The points' starts are also candidates where the points place them: with the region's points
@@ -300,6 +303,29 @@ TEST(RegisterAntenna, AnOutlineMetOnlyFaintlyIsMeasuredWithAWarning) {
   const auto none = register_antenna(model::parametric_panel({}), scene, o);
   EXPECT_FALSE(none.found);
   EXPECT_NE(none.why_not.find("fits its outline"), std::string::npos) << none.why_not;
+}
+
+// An answer must meet edges along enough of its outline to be told from what stands round it:
+// with the answer's limit set under this scene's own outline, the pose that meets it is no answer,
+// and the refusal says why and what would help; its fainter candidates were still weighed.
+TEST(RegisterAntenna, AnAnswerMeetingTooLittleOfItsOutlineIsNone) {
+  const SyntheticScene s = make_scene();
+  const AntennaScene scene = antenna_scene_with_mast(s);
+  const auto clear = register_antenna(model::parametric_panel({}), scene, {});
+  ASSERT_TRUE(clear.found) << clear.why_not;
+
+  RegisterOptions o;
+  o.max_outline_score = o.max_answer_outline_score = 0.5 * clear.outline_score;
+  ASSERT_TRUE(o.Check().ok());
+  const auto none = register_antenna(model::parametric_panel({}), scene, o);
+  EXPECT_FALSE(none.found);
+  EXPECT_GT(none.proposed, 0u);
+  EXPECT_NE(none.why_not.find("meets the photos' edges along little of its outline"), std::string::npos)
+      << none.why_not;
+  EXPECT_NE(none.why_not.find("against a contrasting background"), std::string::npos) << none.why_not;
+
+  o.max_answer_outline_score = 0.5 * o.max_outline_score;
+  EXPECT_FALSE(o.Check().ok()) << "an answer's limit under the clear outline's";
 }
 
 // The clear outline limit only warns: a candidate whose outline fits worse than it, but within the

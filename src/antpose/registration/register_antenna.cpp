@@ -545,6 +545,20 @@ void check_scene(const AntennaScene& s) {
         "register_antenna: no views, a region view out of range, or not one area and viewpoint per view");
 }
 
+// The best pose meets too little of its outline to tell the antenna from what stands round it
+// (RegisterOptions::max_answer_outline_score).
+AntennaRegistration not_seen(const model::AntennaModel& model, double outline_score, std::size_t proposed,
+                             const RegisterOptions& o) {
+  return not_found(
+      proposed,
+      fmt::format("the best pose of the model '{}' meets the photos' edges along little of its outline (score {:.2f}; "
+                  "an answer needs at most {:.2f}, about a third of its outline on edges): the edges it meets may as "
+                  "well be the mount's, the mast's or a neighbour's, and the antenna does not stand out from what is "
+                  "round it in these photos; photos with the antenna against a contrasting background (the sky from "
+                  "another side, a wall) or from nearer would help",
+                  model.name, outline_score, o.max_answer_outline_score));
+}
+
 }  // namespace
 
 std::string to_string(RegistrationVerdict verdict) {
@@ -578,6 +592,8 @@ OptionProblems RegisterOptions::Check() const {
   p.require(min_roi_span > 0 && min_roi_span <= 1, "min_roi_span", "in (0, 1]");
   p.require(max_outline_score > 0 && max_outline_score <= max_faint_outline_score && max_faint_outline_score <= 1,
             "max_outline_score, max_faint_outline_score", "0 < max_outline_score ≤ max_faint_outline_score ≤ 1");
+  p.require(max_outline_score <= max_answer_outline_score && max_answer_outline_score <= 1, "max_answer_outline_score",
+            "in [max_outline_score, 1]");
   return p;
 }
 
@@ -657,6 +673,7 @@ AntennaRegistration register_antenna(const model::AntennaModel& model, const Ant
   }
   auto out = select(s, std::move(kept), o);
   out.proposed = proposals.size();
+  if (out.outline_score > o.max_answer_outline_score) return not_seen(model, out.outline_score, proposals.size(), o);
   check_faces(out, out.panel_shape ? out.panel_shape->model : model, s, o);
   judge_long_edges(out, out.panel_shape ? out.panel_shape->model : model, s, o);
   if (out.outline_score > o.max_outline_score)

@@ -26,8 +26,9 @@
 // min_outline_views). Among those, only the comparison with the best (pose_selection.hpp) rules a
 // candidate out: a fixed score cut would drop the true pose wherever the edges are faint or
 // cluttered and a wrong pose meets other edges a little better, leaving that wrong pose unique.
-// The result's faces are then checked against the region's points (face_plane.hpp), and the pose
-// against each of its long edges left out (long_edge_check.hpp). "Not found"
+// The answer must meet edges along about a third of its outline (max_answer_outline_score). Its
+// faces are then checked against the region's points (face_plane.hpp), and the pose against each
+// of its long edges left out (long_edge_check.hpp). "Not found"
 // is a value: the result says why and what photo or rectangle would help; a pose that fits clearly
 // but spans too little of a rectangle in which nothing else fits more than faintly says the
 // rectangle is drawn too loosely, and poses that fit only against the mast say the mast was found.
@@ -120,6 +121,12 @@ struct RegisterOptions {
   /// the outline meets an edge: no object (a rectangle on the sky) or the wrong model.
   double max_outline_score = 0.5;
   double max_faint_outline_score = 0.8;
+  /// The answer itself must score at most `max_answer_outline_score`: about a third of its
+  /// outline on edges running its way. A pose laid over a mount's pipes, the mast or a neighbour
+  /// can meet that much of their edges, and a panel of its background's brightness meets
+  /// less than they do at its true pose; beyond it the photos do not tell the antenna from what
+  /// stands round it, and the answer is none. Fainter candidates still serve as rivals.
+  double max_answer_outline_score = 2.0 / 3.0;
   std::size_t min_outline_views = 3;
   OptionProblems Check() const;
 };
