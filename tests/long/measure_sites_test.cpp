@@ -108,8 +108,9 @@ std::vector<Site> everyday_sites() {
   };
   sites.push_back(classic(3406, true, true, 3, 3));
   sites.push_back(classic(3711, false, false, 3, 2));
-  // Measured without its neighbours, a nearer panel crosses this one's rectangle and hides most
-  // of its outline: no answer, rather than the neighbour's edges taken for its own.
+  // Measured without its neighbours, with a nearer panel across its rectangle, its best pose meets
+  // too little of its outline to be an answer: none, rather than the neighbour's edges taken for
+  // its own.
   sites.push_back(classic(5111, false, false, 3, 3));
   sites.back().regression = false, sites.back().refuses = "meets the photos' edges along little of its outline";
   sites.push_back(classic(5810, true, false, 2, 1));

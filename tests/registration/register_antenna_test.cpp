@@ -307,7 +307,7 @@ TEST(RegisterAntenna, AnOutlineMetOnlyFaintlyIsMeasuredWithAWarning) {
 
 // An answer must meet edges along enough of its outline to be told from what stands round it:
 // with the answer's limit set under this scene's own outline, the pose that meets it is no answer,
-// and the refusal says why and what would help; its fainter candidates were still weighed.
+// and the refusal says why and what would help.
 TEST(RegisterAntenna, AnAnswerMeetingTooLittleOfItsOutlineIsNone) {
   const SyntheticScene s = make_scene();
   const AntennaScene scene = antenna_scene_with_mast(s);
