@@ -674,8 +674,9 @@ AntennaRegistration register_antenna(const model::AntennaModel& model, const Ant
   auto out = select(s, std::move(kept), o);
   out.proposed = proposals.size();
   if (out.outline_score > o.max_answer_outline_score) return not_seen(model, out.outline_score, proposals.size(), o);
-  check_faces(out, out.panel_shape ? out.panel_shape->model : model, s, o);
-  judge_long_edges(out, out.panel_shape ? out.panel_shape->model : model, s, o);
+  const auto& answer_model = out.panel_shape ? out.panel_shape->model : model;
+  check_faces(out, answer_model, s, o);
+  judge_long_edges(out, answer_model, s, o);
   if (out.outline_score > o.max_outline_score)
     out.warnings.push_back(fmt::format(
         "the model's outline meets the photos' edges only faintly (score {:.2f}; a clearly seen antenna scores "

@@ -123,7 +123,7 @@ struct RegisterOptions {
   double max_faint_outline_score = 0.8;
   /// The answer itself must score at most `max_answer_outline_score`: about a third of its
   /// outline on edges running its way. A pose laid over a mount's pipes, the mast or a neighbour
-  /// can meet that much of their edges, and a panel of its background's brightness meets
+  /// can meet that much of their edges, and a panel of its background's brightness can meet
   /// less than they do at its true pose; beyond it the photos do not tell the antenna from what
   /// stands round it, and the answer is none. Fainter candidates still serve as rivals.
   double max_answer_outline_score = 2.0 / 3.0;
