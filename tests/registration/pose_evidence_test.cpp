@@ -1,5 +1,6 @@
 #include "antpose/registration/pose_evidence.hpp"
 
+#include <cmath>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -29,6 +30,31 @@ TEST(PoseEvidence, ADifferenceThePhotosAgreeOnIsDecisive) {
   EXPECT_NEAR(c.difference, 0.07875, 1e-9);
   EXPECT_EQ(c.units, 8u);
   EXPECT_TRUE(c.decisive);
+}
+
+// Where the photos' outline errors are common to them all, they are one unit: a difference is
+// weighed against their scatter, and one that only the number of photos made decisive is not.
+TEST(PoseEvidence, WithCommonOutlineErrorsThePhotosAreOneUnit) {
+  EvidenceOptions o;
+  const auto better = with_outline({0.10, 0.12, 0.09, 0.11, 0.10, 0.13, 0.12, 0.10});
+  const auto worse = with_outline({0.12, 0.22, 0.11, 0.19, 0.10, 0.20, 0.17, 0.14});
+  const Comparison independent = compare_shape(better, worse, o);
+  EXPECT_TRUE(independent.decisive);
+  o.outline_errors_common = true;
+  const Comparison common = compare_shape(better, worse, o);
+  EXPECT_DOUBLE_EQ(common.difference, independent.difference);
+  EXPECT_NEAR(common.standard_error, std::sqrt(8.0) * independent.standard_error, 1e-12);
+  EXPECT_FALSE(common.decisive);
+  auto placed = [](PoseEvidence e) {
+    e.placement = e.outline;
+    return e;
+  };
+  o.outline_errors_common = false;
+  EXPECT_TRUE(compare_placement(placed(better), placed(worse), o).decisive);
+  o.outline_errors_common = true;
+  EXPECT_FALSE(compare_placement(placed(better), placed(worse), o).decisive) << "the placement is the photos' too";
+  // A difference far beyond the photos' scatter still decides.
+  EXPECT_TRUE(compare_shape(better, with_outline({0.60, 0.63, 0.58, 0.62, 0.61, 0.64, 0.62, 0.60}), o).decisive);
 }
 
 TEST(PoseEvidence, ADifferenceOnePhotoMakesIsNot) {

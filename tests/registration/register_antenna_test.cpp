@@ -305,6 +305,25 @@ TEST(RegisterAntenna, AnOutlineMetOnlyFaintlyIsMeasuredWithAWarning) {
   EXPECT_NE(none.why_not.find("fits its outline"), std::string::npos) << none.why_not;
 }
 
+// A radome rounder than the shapes profiled (shape_fit.hpp): its edges lie further inside than any
+// rounding the profile tries, the shape stays open, and the answer says so and carries its poses.
+TEST(RegisterAntenna, EdgesInsideTheRoundestOutlineAreMeasuredWithAWarning) {
+  fixture::SceneSpec spec;
+  spec.panel.edge_radius_m = 0.075;
+  const SyntheticScene s = make_scene(spec);
+  const auto r = register_antenna(model::parametric_panel({}), antenna_scene_with_mast(s, spec.panel), {});
+  ASSERT_TRUE(r.found) << r.why_not;
+  ASSERT_TRUE(r.panel_shape);
+  EXPECT_FALSE(r.panel_shape->bracketed);
+  const auto warned = std::any_of(r.warnings.begin(), r.warnings.end(), [](const std::string& w) {
+    return w.find("further inside its box than the outline of its roundest radome") != std::string::npos &&
+           w.find("the σ covers every rounding") != std::string::npos;
+  });
+  EXPECT_TRUE(warned);
+  const double error = rotation_distance(r.T_board_antenna.linear(), s.T_board_antenna.linear());
+  EXPECT_LT(error, 3 * std::sqrt(r.rotation_covariance_board().trace()));
+}
+
 // An answer must meet edges along enough of its outline to be told from what stands round it:
 // with the answer's limit set under this scene's own outline, the pose that meets it is no answer,
 // and the refusal says why and what would help.

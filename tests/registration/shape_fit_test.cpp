@@ -103,6 +103,35 @@ TEST(ShapeFit, TheEndCapsRimIsFittedAndTheDowntiltWithIt) {
   EXPECT_LT(2 * error(fit), error(without));
 }
 
+// A radome whose edges show further inside than the roundest model's outline (here one rounder
+// than the range, as shading on a pale rounded radome shows): the profile presses against the
+// largest radius, is not bracketed, and weighs the shapes against the photos' scatter, not their
+// mean's standard error: more shapes stay within, and their poses' spread covers the error of the
+// best one.
+TEST(ShapeFit, EdgesFurtherInsideThanAnyRoundingLeaveTheShapeOpen) {
+  SceneSpec spec;
+  spec.panel.edge_radius_m = 0.075;
+  spec.view_offsets_deg = {0.0, 5.0, 10.0, 15.0, 20.0, 25.0, 30.0};
+  const auto s = make_scene(spec);
+  const auto model = model::parametric_panel({});
+  const auto fit = fit_shape(model, s.T_board_antenna, s.views, s.intrinsics, polish(), {}, {});
+  ASSERT_TRUE(fit.fitted);
+  EXPECT_FALSE(fit.bracketed);
+  EXPECT_DOUBLE_EQ(fit.radius_m, 0.06);
+  const Vec3 error = log_so3(fit.outline.T_board_antenna.linear() * s.T_board_antenna.linear().transpose());
+  const double sigma = std::sqrt(fit.spread_board.trace());
+  std::printf("within %zu of %zu shapes, spread %.2f°, error of the best %.2f°\n", fit.within.size(),
+              fit.radii_m.size(), rad2deg(sigma), rad2deg(error.norm()));
+  EXPECT_EQ(fit.within.size(), fit.radii_m.size());  // against the photos' scatter none is ruled out here
+  EXPECT_LT(error.norm(), 3 * sigma);
+
+  SceneSpec round;  // the panel the model describes, its edges rounded within the range: bracketed
+  round.panel.edge_radius_m = 0.03;
+  round.view_offsets_deg = spec.view_offsets_deg;
+  const auto r = make_scene(round);
+  EXPECT_TRUE(fit_shape(model, r.T_board_antenna, r.views, r.intrinsics, polish(), {}, {}).bracketed);
+}
+
 TEST(ShapeFit, AMeshFromAFileKeepsItsShape) {
   const auto s = make_scene();
   auto model = model::parametric_panel({});

@@ -44,6 +44,14 @@ Stratum paired(const std::vector<double>& better, const std::vector<double>& oth
   return s;
 }
 
+// The photos' stratum: as paired, or as one unit where their errors are common
+// (EvidenceOptions::outline_errors_common).
+Stratum photos(const std::vector<double>& better, const std::vector<double>& other, const EvidenceOptions& o) {
+  Stratum s = paired(better, other);
+  if (o.outline_errors_common) s.variance_of_mean *= static_cast<double>(s.n);
+  return s;
+}
+
 Comparison combine(const std::vector<std::pair<Stratum, double>>& strata, const EvidenceOptions& o) {
   Comparison c;
   double variance = 0.0;
@@ -102,12 +110,12 @@ double PoseEvidence::side_score(const EvidenceOptions& o) const {
 }
 
 Comparison compare_shape(const PoseEvidence& better, const PoseEvidence& other, const EvidenceOptions& o) {
-  return combine({{paired(better.outline, other.outline), 1.0}, {paired(better.points, other.points), o.points_weight}},
-                 o);
+  return combine(
+      {{photos(better.outline, other.outline, o), 1.0}, {paired(better.points, other.points), o.points_weight}}, o);
 }
 
 Comparison compare_placement(const PoseEvidence& better, const PoseEvidence& other, const EvidenceOptions& o) {
-  return combine({{paired(better.placement, other.placement), 1.0}}, o);
+  return combine({{photos(better.placement, other.placement, o), 1.0}}, o);
 }
 
 Comparison compare_side(const PoseEvidence& better, const PoseEvidence& other, const EvidenceOptions& o) {

@@ -71,6 +71,10 @@ struct EvidenceOptions {
   double side_mount_outline_weight = 1.0;  // the vertical structure's photos
   double decisive_z = 2.5;
   double min_difference = 0.01;
+  // Whether the photos' outline errors are common to them all, as where no shape of the panel
+  // explains where its edges lie (shape_fit.hpp, unbracketed): the photos then count as one unit,
+  // their mean difference weighed against their scatter, not against that mean's standard error.
+  bool outline_errors_common = false;
   OptionProblems Check() const;
 };
 

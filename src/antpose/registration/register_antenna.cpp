@@ -461,9 +461,13 @@ AntennaRegistration select(const AntennaScene& s, std::vector<Refined> kept, con
   const auto best_shape = static_cast<std::size_t>(
       std::min_element(candidates.begin(), candidates.end(), ranks_before) - candidates.begin());
   add_mount_outline(candidates[best_shape].evidence, twins[best_shape], kept[best_shape], s, o);
+  // Where no shape of the panel explains the best's edges, no comparison with it may take the
+  // photos for independent units (pose_evidence.hpp).
+  auto evidence = o.evidence;
+  evidence.outline_errors_common = kept[best_shape].panel_shape && !kept[best_shape].panel_shape->bracketed;
   AntennaRegistration out;
   out.found = true;
-  out.selection = select_pose(candidates, twins, s.mast, o.evidence, o.selection);
+  out.selection = select_pose(candidates, twins, s.mast, evidence, o.selection);
   const auto& sel = out.selection;
   Refined& best = kept[sel.best];
   out.T_board_antenna = sel.turned ? turned_round(best.candidate.T_board_antenna) : best.candidate.T_board_antenna;
@@ -528,6 +532,19 @@ void judge_long_edges(AntennaRegistration& out, const model::AntennaModel& model
         "side, or in other light) would settle it",
         long_edge_name(e.edge), rad2deg(e.turn_rad), e.distance));
   }
+}
+
+// An answer whose shape profile presses against the roundest radome (shape_fit.hpp, unbracketed)
+// says so: its σ carries the shapes, but only other photos can settle the pose.
+void warn_of_open_shape(AntennaRegistration& out) {
+  if (!out.panel_shape || out.panel_shape->bracketed) return;
+  out.warnings.push_back(fmt::format(
+      "the panel's long edges lie further inside its box than the outline of its roundest radome (edge radius "
+      "{:.0f} mm): the edges seen are its shading, where the rounded radome turns from the light, not its outline "
+      "(a pale radome before a bright background), and the photos cannot tell how round it is; the σ covers every "
+      "rounding; photos with its edges against a darker background (from another side, or in other light) would "
+      "settle it",
+      1000 * out.panel_shape->radius_m));
 }
 
 // "Not found", and why.
@@ -677,6 +694,7 @@ AntennaRegistration register_antenna(const model::AntennaModel& model, const Ant
   const auto& answer_model = out.panel_shape ? out.panel_shape->model : model;
   check_faces(out, answer_model, s, o);
   judge_long_edges(out, answer_model, s, o);
+  warn_of_open_shape(out);
   if (out.outline_score > o.max_outline_score)
     out.warnings.push_back(fmt::format(
         "the model's outline meets the photos' edges only faintly (score {:.2f}; a clearly seen antenna scores "

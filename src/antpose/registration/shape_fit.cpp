@@ -74,7 +74,9 @@ double parabola_vertex(double at, double step, double a, double b, double c) {
 // region (out to decisive_z), not its one-σ extent. The shapes ruled out stay out: their poses may
 // have slid into another basin, and a z from the units' scatter has no Gaussian tails to give them
 // their due. A difference below min_difference is no evidence however small its scatter, so the
-// standard error is taken as at least the one that makes min_difference borderline.
+// standard error is taken as at least the one that makes min_difference borderline. Unbracketed
+// (shape_fit.hpp), the photos misread the outline alike and count as one unit
+// (EvidenceOptions::outline_errors_common).
 void weigh_shapes(const Profile& p, const Photos& photos, const EvidenceOptions& evidence, ShapeFit& fit) {
   const auto outline = [&](std::size_t k) {
     PoseEvidence e;
@@ -83,12 +85,14 @@ void weigh_shapes(const Profile& p, const Photos& photos, const EvidenceOptions&
                     .cost;
     return e;
   };
+  EvidenceOptions weighed = evidence;
+  weighed.outline_errors_common = !fit.bracketed;
   const PoseEvidence at_best = outline(p.best);
   const Mat3& R_best = p.results[p.best].T_board_antenna.linear();
   const double least_error = evidence.min_difference / evidence.decisive_z;
   double weights = 0.0;
   for (std::size_t k = 0; k < p.results.size(); ++k) {
-    const auto c = k == p.best ? Comparison{} : compare_shape(at_best, outline(k), evidence);
+    const auto c = k == p.best ? Comparison{} : compare_shape(at_best, outline(k), weighed);
     const double z = std::max(c.difference, 0.0) / std::max(c.standard_error, least_error);
     fit.likelihoods.push_back(std::exp(-0.5 * z * z));
     if (c.decisive) continue;
@@ -145,6 +149,7 @@ ShapeFit fit_shape(const model::AntennaModel& model, const Iso3& T_board_antenna
   fit.model = p.models[p.best];
   fit.outline = p.results[p.best];
   fit.radii_m = p.radii, fit.rims_m = p.rims, fit.scores = p.scores;
+  fit.bracketed = i + 1 < n;
   weigh_shapes(p, photos, evidence, fit);
   return fit;
 }

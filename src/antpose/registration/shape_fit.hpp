@@ -16,6 +16,14 @@
 // cell; the best shape is kept. The poses of the other shapes, each weighted by its likelihood
 // relative to the best's (pose_evidence.hpp's paired test), are added to the covariance: the shape
 // is a nuisance whose uncertainty the attitude must carry.
+//
+// Where the best radius is the largest tried, the profile is not bracketed: the photos' edges lie
+// further inside the box than the outline of any rounding, which the radome's shape cannot do.
+// A rounded radome shows it where its outline has little contrast (a pale radome before a bright
+// sky): the edge seen is its shading's, where the surface turns from the light, some way in from
+// its outline and alike in every photo. The paired test's noise, the photos' scatter about their
+// mean, then misses that common error, and the photos count as one unit: the shapes are weighed
+// against the scatter itself, and the attitude carries the poses of the shapes it allows.
 #pragma once
 
 #include <cstddef>
@@ -40,6 +48,7 @@ struct ShapeOptions {
 
 struct ShapeFit {
   bool fitted = false;                 // false: not a parametric panel, or no shape refined to a usable outline
+  bool bracketed = true;               // false: the best radius is the largest tried (the file comment)
   double radius_m = 0.0, rim_m = 0.0;  // the best edge radius and end caps' rim
   model::AntennaModel model;           // the panel of that shape
   SilhouetteResult outline;            // its refinement
