@@ -90,6 +90,19 @@ TEST(LongEdgeCheck, AnEdgeThatDecidesThePoseAgainstTheOthersIsFound) {
   EXPECT_EQ(disagreeing, 1);
 }
 
+// Only an edge that disagrees and turns the pose as far as a rival stands leaves a second pose.
+TEST(LongEdgeCheck, AnEdgeThatTurnsThePoseAsFarAsARivalLeavesAnotherPose) {
+  const double rival = deg2rad(10.0);
+  LongEdgeLeftOut agrees, near, far;
+  agrees.turn_rad = deg2rad(20.0);  // loosely held without it, but within both σ
+  near.disagrees = far.disagrees = true;
+  near.turn_rad = deg2rad(4.0), far.turn_rad = deg2rad(20.0);
+  EXPECT_FALSE(leaves_another_pose({}, rival));
+  EXPECT_FALSE(leaves_another_pose({agrees, near}, rival));
+  EXPECT_TRUE(leaves_another_pose({agrees, near, far}, rival));
+  EXPECT_FALSE(leaves_another_pose({far}, deg2rad(25.0)));
+}
+
 TEST(LongEdgeCheck, LongEdgesAreNamedByTheFacesThatMeetThere) {
   EXPECT_EQ(long_edge_of(Vec3(0.1, 0.05, -0.5), Vec3(0.1, 0.05, 0.5)), 3);
   EXPECT_EQ(long_edge_of(Vec3(-0.1, 0.05, 0.5), Vec3(-0.1, 0.05, -0.5)), 2);

@@ -119,7 +119,7 @@ void explain_verdict(AntennaMeasurement& m, const registration::AntennaRegistrat
         rad2deg(a.downtilt), v.difference, v.standard_error, v.units));
     return;
   }
-  if (r.verdict == registration::RegistrationVerdict::kAmbiguousShape && r.selection.runner_up) {
+  if (r.verdict == registration::RegistrationVerdict::kAmbiguousShape && !r.rivals.empty() && r.selection.runner_up) {
     const auto& v = *r.selection.runner_up;
     m.warnings.push_back(fmt::format(
         "the registration is ambiguous: {} other pose(s) fit the photos and points about as well (score difference "

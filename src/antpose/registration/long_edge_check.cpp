@@ -57,6 +57,11 @@ std::vector<LongEdgeLeftOut> check_long_edges(const model::Mesh& mesh_antenna, c
   return out;
 }
 
+bool leaves_another_pose(const std::vector<LongEdgeLeftOut>& left_out, double min_turn_rad) {
+  return std::any_of(left_out.begin(), left_out.end(),
+                     [&](const LongEdgeLeftOut& e) { return e.disagrees && e.turn_rad > min_turn_rad; });
+}
+
 std::string long_edge_name(int edge) { return std::string(edge & 1 ? "+x" : "-x") + (edge & 2 ? "+y" : "-y"); }
 
 }  // namespace antpose::registration

@@ -62,6 +62,11 @@ std::vector<LongEdgeLeftOut> check_long_edges(const model::Mesh& mesh_antenna, c
                                               const camera::CameraIntrinsics& intrinsics,
                                               const SilhouetteOptions& polish, const LongEdgeCheckOptions& options);
 
+/// Whether a long edge that disagrees turns the pose by more than `min_turn_rad` when left out:
+/// the other edges then hold a second pose, as far from the whole outline's as a rival
+/// (pose_selection.hpp's rival_min_deg), and the answer is as ambiguous as with a rival.
+bool leaves_another_pose(const std::vector<LongEdgeLeftOut>& left_out, double min_turn_rad);
+
 /// "+x+y" and so on: the faces, in the antenna frame, that meet at long edge `edge`.
 std::string long_edge_name(int edge);
 

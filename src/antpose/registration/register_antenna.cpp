@@ -516,7 +516,8 @@ void check_faces(AntennaRegistration& out, const model::AntennaModel& model, con
 }
 
 // The result against each of its long edges left out (long_edge_check.hpp): each edge that decides
-// the pose against the others adds a warning (the measurement's σ covers the pose without it).
+// the pose against the others adds a warning (the measurement's σ covers the pose without it), and
+// one whose absence turns the pose as far as a rival stands makes a unique answer ambiguous.
 void judge_long_edges(AntennaRegistration& out, const model::AntennaModel& model, const AntennaScene& s,
                       const RegisterOptions& o) {
   auto polish = polish_of(o.refine);
@@ -532,6 +533,9 @@ void judge_long_edges(AntennaRegistration& out, const model::AntennaModel& model
         "side, or in other light) would settle it",
         long_edge_name(e.edge), rad2deg(e.turn_rad), e.distance));
   }
+  if (out.verdict == RegistrationVerdict::kUnique &&
+      leaves_another_pose(out.long_edges_left_out, deg2rad(o.selection.rival_min_deg)))
+    out.verdict = RegistrationVerdict::kAmbiguousShape;
 }
 
 // An answer whose shape profile presses against the roundest radome (shape_fit.hpp, unbracketed)
