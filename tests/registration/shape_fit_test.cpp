@@ -23,12 +23,17 @@ SilhouetteOptions polish() {
 }
 
 // A panel whose vertical edges are rounder (45 mm) than its datasheet model's (20 mm), seen over
-// 30° from 15° off its front: fitted with the model's rounding the yaw makes up for it.
-TEST(ShapeFit, TheRadomesRoundingIsFittedAndTheYawWithIt) {
+// 30° from 15° off its front.
+fixture::SyntheticScene rounder_panel() {
   SceneSpec spec;
   spec.panel.edge_radius_m = 0.045;
   spec.view_offsets_deg = {0.0, 5.0, 10.0, 15.0, 20.0, 25.0, 30.0};
-  const auto s = make_scene(spec);
+  return make_scene(spec);
+}
+
+// Fitted with the model's rounding the yaw makes up for it.
+TEST(ShapeFit, TheRadomesRoundingIsFittedAndTheYawWithIt) {
+  const auto s = rounder_panel();
   const auto model = model::parametric_panel({});  // 20 mm
   ASSERT_TRUE(model.panel);
   auto o = polish();
@@ -72,6 +77,25 @@ TEST(ShapeFit, TheRadomesRoundingIsFittedAndTheYawWithIt) {
       EXPECT_GT(best_rim[i - 1].second, best_rim[i].second) << best_rim[i].first;
     }
   }
+}
+
+// The profile's spread carried to another refinement of the answer: refined as the profile was
+// from the best shape's pose, each shape lands where the profile put it and the spread is the
+// profile's; a panel not profiled has none.
+TEST(ShapeFit, TheShapesSpreadRefinedAsTheProfileWasIsTheProfiles) {
+  const auto s = rounder_panel();
+  const auto model = model::parametric_panel({});
+  const auto fit = fit_shape(model, s.T_board_antenna, s.views, s.intrinsics, polish(), {}, {});
+  ASSERT_TRUE(fit.fitted);
+  ASSERT_GE(fit.within.size(), 2u);
+  const Mat3 spread =
+      spread_of_shapes(fit, fit.model, fit.outline.T_board_antenna, s.views, s.intrinsics, polish(), {});
+  std::printf("spread %.3f°, the profile's %.3f° (root of the traces)\n", rad2deg(std::sqrt(spread.trace())),
+              rad2deg(std::sqrt(fit.spread_board.trace())));
+  EXPECT_NEAR(std::sqrt(spread.trace()), std::sqrt(fit.spread_board.trace()),
+              0.25 * std::sqrt(fit.spread_board.trace()) + deg2rad(0.01));
+  ShapeFit none;
+  EXPECT_TRUE(spread_of_shapes(none, model, s.T_board_antenna, s.views, s.intrinsics, polish(), {}).isZero());
 }
 
 // A short panel with end caps standing 8 mm out of its radome, seen from well below over a

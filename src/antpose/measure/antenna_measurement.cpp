@@ -178,8 +178,9 @@ void apply_registration(AntennaMeasurement& m, const model::AntennaModel& model,
         "edges show the downtilt, settle it");
   if (rad2deg(r.dilation_yaw_sigma_rad) > o.warn_dilation_yaw_sigma_deg)
     m.warnings.push_back(fmt::format(
-        "the outline's width barely changes with yaw in these photos: a blur of a fraction of a pixel turns the yaw "
-        "by {:.1f}°, which the azimuth σ includes; photograph the antenna over a wider arc or from nearer",
+        "the outline's width barely changes with yaw in these photos (a tenth of a pixel of blur would turn the yaw "
+        "by {:.1f}°): the yaw rests on where the long edges lie, and the azimuth σ says how well they fix it; "
+        "photograph the antenna over a wider arc or from nearer",
         rad2deg(r.dilation_yaw_sigma_rad)));
   explain_verdict(m, r, c);
 }

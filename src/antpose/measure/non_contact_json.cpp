@@ -119,7 +119,10 @@ nlohmann::json antenna_json(const AntennaMeasurement& m) {
     long_edges.push_back({{"edge", registration::long_edge_name(e.edge)},
                           {"turn_deg", rad2deg(e.turn_rad)},
                           {"distance", e.distance},
-                          {"disagrees", e.disagrees}});
+                          {"disagrees", e.disagrees},
+                          {"samples", e.samples},
+                          {"whole_samples", e.whole_samples},
+                          {"R_board_antenna", io::matrix_rows_json(e.T_board_antenna.linear())}});
   a["registration"] = {{"candidates", m.candidates},
                        {"face_planes", faces},
                        {"long_edges_left_out", long_edges},

@@ -432,14 +432,21 @@ void add_mount_outline(PoseEvidence& as_is, PoseEvidence& twin, const Refined& k
   twin.mount_outline = sides.before->view_costs;
 }
 
+// An outline's rotation covariance by its sources (silhouette.hpp OutlineCovarianceParts); a part
+// that is nil (the whole outline's dilation, absorbed where the width is free) is left out.
+std::vector<UncertaintySource> outline_sources(const SilhouetteResult& outline) {
+  const auto& parts = outline.covariance_parts;
+  std::vector<UncertaintySource> out{{"outline noise", parts.noise.topLeftCorner<3, 3>()},
+                                     {"model shape tolerance", parts.shape.topLeftCorner<3, 3>()},
+                                     {"edge bias", parts.edge_bias.topLeftCorner<3, 3>()}};
+  if (!parts.dilation.isZero()) out.push_back({"outline width", parts.dilation.topLeftCorner<3, 3>()});
+  return out;
+}
+
 // The rotation covariance of a refined candidate by its sources: its outline's parts, and the spread
 // of the shapes that fit as well where its shape was profiled (shape_fit.hpp).
 std::vector<UncertaintySource> rotation_sources(const Refined& k) {
-  const auto& parts = k.outline.covariance_parts;
-  std::vector<UncertaintySource> out{{"outline noise", parts.noise.topLeftCorner<3, 3>()},
-                                     {"model shape tolerance", parts.shape.topLeftCorner<3, 3>()},
-                                     {"edge bias", parts.edge_bias.topLeftCorner<3, 3>()},
-                                     {"outline width", parts.dilation.topLeftCorner<3, 3>()}};
+  auto out = outline_sources(k.outline);
   if (k.panel_shape) out.push_back({"panel shape profile", k.panel_shape->spread_board});
   return out;
 }
@@ -515,13 +522,42 @@ void check_faces(AntennaRegistration& out, const model::AntennaModel& model, con
   }
 }
 
+// How the answer is polished and its long edges left out: at full resolution, with the model's box
+// as the outline and its width free where RegisterOptions::free_answer_width.
+SilhouetteOptions answer_polish(const model::AntennaModel& model, const RegisterOptions& o) {
+  auto polish = polish_of(o.refine);
+  polish.outline_box_m = model::outline_box(model);
+  polish.free_outline_width = o.free_answer_width;
+  return polish;
+}
+
+// The answer polished with the outline's width free (RegisterOptions::free_answer_width): its pose
+// and the outline's parts of its σ follow, where the polish converges, and so does the profiled
+// shape's spread: where the width is free, the edge radius (which mostly sets the outline's width)
+// turns the pose far less. Not where the profile is open (shape_fit.hpp): no rounding explains
+// that outline, whose departure from the model then changes with the view, not alike on every
+// side, and the profile's pose and σ, which carry every rounding, stay.
+void free_the_width(AntennaRegistration& out, const model::AntennaModel& model, const AntennaScene& s,
+                    const RegisterOptions& o) {
+  if (!o.free_answer_width || (out.panel_shape && !out.panel_shape->bracketed)) return;
+  const auto polish = answer_polish(model, o);
+  const auto freed = refine_by_silhouette(model.mesh_antenna, out.T_board_antenna, s.views, s.intrinsics, polish);
+  if (!freed.converged && !freed.stopped_at_iteration_limit) return;
+  out.T_board_antenna = freed.T_board_antenna;
+  out.rotation_covariance_sources = outline_sources(freed);
+  if (out.panel_shape)
+    out.rotation_covariance_sources.push_back(
+        {"panel shape profile",
+         spread_of_shapes(*out.panel_shape, model, out.T_board_antenna, s.views, s.intrinsics, polish, o.panel_shape)});
+  out.outline_shape_sigma_m = freed.shape_sigma_m;
+}
+
 // The result against each of its long edges left out (long_edge_check.hpp): each edge that decides
 // the pose against the others adds a warning (the measurement's σ covers the pose without it), and
 // one whose absence turns the pose as far as a rival stands makes a unique answer ambiguous.
 void judge_long_edges(AntennaRegistration& out, const model::AntennaModel& model, const AntennaScene& s,
                       const RegisterOptions& o) {
-  auto polish = polish_of(o.refine);
-  polish.outline_box_m = model::outline_box(model);
+  const auto polish = answer_polish(model, o);
   out.long_edges_left_out =
       check_long_edges(model.mesh_antenna, out.T_board_antenna, s.views, s.intrinsics, polish, o.long_edges);
   for (const auto& e : out.long_edges_left_out) {
@@ -696,6 +732,7 @@ AntennaRegistration register_antenna(const model::AntennaModel& model, const Ant
   out.proposed = proposals.size();
   if (out.outline_score > o.max_answer_outline_score) return not_seen(model, out.outline_score, proposals.size(), o);
   const auto& answer_model = out.panel_shape ? out.panel_shape->model : model;
+  free_the_width(out, answer_model, s, o);
   check_faces(out, answer_model, s, o);
   judge_long_edges(out, answer_model, s, o);
   warn_of_open_shape(out);

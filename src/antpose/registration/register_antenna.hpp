@@ -109,6 +109,11 @@ struct RegisterOptions {
   reconstruction::MastSearchOptions mount_search;  // vertical structure behind and before the best
   FacePlaneOptions face_plane;                     // the result's faces checked against its points (face_plane.hpp)
   LongEdgeCheckOptions long_edges;                 // the result against each long edge left out (long_edge_check.hpp)
+  /// The answer polished at last with the outline's width free (SilhouetteOptions::
+  /// free_outline_width), and its long edges checked so: the candidates are compared by their
+  /// outline as it is, but the answer's pose and σ rest on where its edges lie, not on the width
+  /// that the shading of a rounded radome narrows alike in every photo.
+  bool free_answer_width = true;
   std::size_t shape_candidates = 3;                // that many, by their outline
   double same_pose_deg = 2.0, same_pose_m = 0.03;  // refined candidates this close are one
   double min_roi_span = 0.55;                      // outline_search.hpp's rectangle_fit

@@ -154,4 +154,21 @@ ShapeFit fit_shape(const model::AntennaModel& model, const Iso3& T_board_antenna
   return fit;
 }
 
+Mat3 spread_of_shapes(const ShapeFit& fit, const model::AntennaModel& model, const Iso3& T_board_antenna,
+                      const std::vector<SilhouetteView>& views, const camera::CameraIntrinsics& intrinsics,
+                      const SilhouetteOptions& polish, const ShapeOptions& options) {
+  if (!fit.fitted || !model.panel) return Mat3::Zero();
+  Mat3 spread = Mat3::Zero();
+  double weights = 0.0;
+  for (const std::size_t k : fit.within) {
+    weights += fit.likelihoods[k];
+    if (fit.radii_m[k] == fit.radius_m && fit.rims_m[k] == fit.rim_m) continue;  // the pose itself
+    const auto m = reshaped(model, fit.radii_m[k], fit.rims_m[k], options.cap_height_m);
+    const auto r = refine_by_silhouette(m.mesh_antenna, T_board_antenna, views, intrinsics, for_model(polish, m));
+    const Vec3 d = log_so3(r.T_board_antenna.linear() * T_board_antenna.linear().transpose());
+    spread += fit.likelihoods[k] * d * d.transpose();
+  }
+  return weights > 0 ? Mat3(spread / weights) : Mat3::Zero();
+}
+
 }  // namespace antpose::registration

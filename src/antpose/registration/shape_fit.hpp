@@ -68,4 +68,13 @@ ShapeFit fit_shape(const model::AntennaModel& model, const Iso3& T_board_antenna
                    const std::vector<SilhouetteView>& views, const camera::CameraIntrinsics& intrinsics,
                    const SilhouetteOptions& polish, const EvidenceOptions& evidence, const ShapeOptions& options);
 
+/// The spread of the shapes `fit` allows (its `within`, weighed by their likelihoods), each the panel
+/// `model` reshaped and refined with `polish` from `T_board_antenna`, about that pose (rad², board
+/// frame): the profile's nuisance carried over to the answer refined otherwise than the profile
+/// was (register_antenna.hpp's free_answer_width), `T_board_antenna` being its best shape's pose
+/// so refined. Zero where `fit` was not fitted.
+Mat3 spread_of_shapes(const ShapeFit& fit, const model::AntennaModel& model, const Iso3& T_board_antenna,
+                      const std::vector<SilhouetteView>& views, const camera::CameraIntrinsics& intrinsics,
+                      const SilhouetteOptions& polish, const ShapeOptions& options);
+
 }  // namespace antpose::registration

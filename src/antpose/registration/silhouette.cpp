@@ -27,32 +27,62 @@ struct Normal {
   double sum_w = 0, sum_wr2 = 0;
   std::size_t inliers = 0, samples = 0;
   double c = 0;  // Tukey's cut-off, full-resolution px
-  double weight(double r) const {
+  // With the outline's width free (SilhouetteOptions::free_outline_width): the long edges' samples'
+  // robust centre (their weights are taken about it), and the common offset's estimate and their
+  // weighted mean Jacobian, by which H and b are reduced (the offset eliminated, a Schur complement).
+  double centre = 0, offset = 0;
+  Vec6 mean_J = Vec6::Zero();
+  double centre_of(const Sample& s) const { return s.on_long_edge ? centre : 0.0; }
+  double weight(const Sample& s) const {
+    const double r = s.r - centre_of(s);
     if (!(std::abs(r) < c)) return 0.0;
     const double u = r / c;
     return (1 - u * u) * (1 - u * u);
   }
+  // The sample's Jacobian as the reduced equations see it: a long edge's less the mean.
+  Vec6 J(const Sample& s) const { return s.on_long_edge ? Vec6(s.J.transpose() - mean_J) : Vec6(s.J.transpose()); }
 };
+
+// The long edges' samples' median residual, full-resolution px (0 without any): the outline's
+// width against the model's, robustly.
+double long_edge_median(const Gathered& g) {
+  std::vector<double> r;
+  for (const auto& v : g.per_view)
+    for (const auto& s : v)
+      if (s.on_long_edge) r.push_back(s.r);
+  return r.empty() ? 0.0 : median(std::move(r));
+}
 
 Normal normal_equations(const Gathered& g, double scale, const SilhouetteOptions& o) {
   Normal n;
+  if (o.free_outline_width) n.centre = long_edge_median(g);
   std::vector<double> r;
   for (const auto& v : g.per_view)
-    for (const auto& s : v) r.push_back(s.r / scale);
+    for (const auto& s : v) r.push_back((s.r - n.centre_of(s)) / scale);
   n.samples = r.size();
   if (r.empty()) return n;
   const double sigma = std::max(0.5, robust_sigma(std::move(r)));
   n.c = o.tukey_c * sigma * scale;
+  double long_w = 0, long_wr = 0;
+  Vec6 long_wJ = Vec6::Zero();
   for (const auto& v : g.per_view)
     for (const auto& s : v) {
-      const double w = n.weight(s.r);
+      const double w = n.weight(s);
       if (w <= 0) continue;
       n.H += w * s.J.transpose() * s.J;
       n.b += w * s.J.transpose() * s.r;
       n.sum_w += w;
       n.sum_wr2 += w * s.r * s.r;
       ++n.inliers;
+      if (s.on_long_edge) long_w += w, long_wr += w * s.r, long_wJ += w * s.J.transpose();
     }
+  if (o.free_outline_width && long_w > 0) {
+    n.mean_J = long_wJ / long_w;
+    n.offset = long_wr / long_w;
+    n.H -= long_w * n.mean_J * n.mean_J.transpose();
+    n.b -= n.mean_J * long_wr;
+    n.sum_wr2 -= long_wr * n.offset;
+  }
   return n;
 }
 
@@ -96,9 +126,10 @@ double score(const Gathered& g, const SilhouetteOptions& o, bool with_attachment
   if (candidates == 0) return 1.0;
   double sum = with_attachments ? c.attachment_cost : 0.0;
   std::size_t found = 0;
+  const double centre = o.free_outline_width ? long_edge_median(g) : 0.0;  // the outline's width as found
   for (const auto& v : g.per_view)
     for (const auto& s : v) {
-      sum += edge_cost(s.r, o);
+      sum += edge_cost(s.r - (s.on_long_edge ? centre : 0.0), o);
       ++found;
     }
   return (sum + double(c.candidates - found)) / double(candidates);
@@ -278,7 +309,8 @@ void covariance_at(SilhouetteResult& result, const Gathered& g, const Normal& n,
                    const std::optional<RotationPrior>& prior, const EdgeMesh& m, const Pose& pose,
                    const SilhouetteOptions& o) {
   result.rms_px = std::sqrt(n.sum_wr2 / n.sum_w);
-  const double sigma2 = n.sum_wr2 / std::max(1.0, n.sum_w - 6.0);
+  const double parameters = o.free_outline_width ? 7.0 : 6.0;
+  const double sigma2 = n.sum_wr2 / std::max(1.0, n.sum_w - parameters);
   const double inflation = std::max(1.0, o.correlation_length_px / o.sample_spacing_px);
   Mat6 noise = sigma2 * inflation * n.H;
   if (prior)
@@ -291,12 +323,15 @@ void covariance_at(SilhouetteResult& result, const Gathered& g, const Normal& n,
   Vec6 dilation = Vec6::Zero();
   for (const auto& view : g.per_view)
     for (const auto& s : view) {
-      const double w = n.weight(s.r);
+      const double w = n.weight(s);
       if (w <= 0) continue;
-      if (s.px_per_m > 0) offsets[s.edge].add(w, s.px_per_m, s.r);
-      shape[s.edge] += w * s.px_per_m * s.J.transpose();
-      bias[s.edge] += w * o.edge_bias_px * s.J.transpose();
-      dilation += w * o.outline_dilation_px * s.J.transpose();
+      // With the width free, a long edge's sample moves the pose only by its Jacobian's departure
+      // from their mean, and its edge's offset is measured beyond their common one.
+      const Vec6 J = n.J(s);
+      if (s.px_per_m > 0) offsets[s.edge].add(w, s.px_per_m, s.r - (s.on_long_edge ? n.offset : 0.0));
+      shape[s.edge] += w * s.px_per_m * J;
+      bias[s.edge] += w * o.edge_bias_px * J;
+      dilation += w * o.outline_dilation_px * J;
     }
   const ShapeSigma shape_error = shape_sigma(offsets, o);
   result.shape_sigma_m = shape_error.sigma_m;

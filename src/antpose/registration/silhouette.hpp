@@ -130,6 +130,15 @@ struct SilhouetteOptions {
   double shape_prior_edges = 4;       // ν₀: σ₀'s weight, in mesh edges, against the offsets measured
   double edge_bias_px = 0.1;          // edge-localisation bias per mesh edge, all views (covariance)
   double outline_dilation_px = 0.10;  // the same, common to the whole outline in all views (covariance)
+  // The outline's width left free: an offset common to the samples of the model's long edges along
+  // their normals (the outline found wider or narrower than the model's, px) is estimated with the
+  // pose and eliminated from its normal equations, the score taken about it. The pose then rests
+  // on where the long edges lie, not on how far apart: a rounded radome's shading near its outline,
+  // or a background of its own brightness, narrows the outline found by pixels alike in every
+  // photo, which a narrow panel seen face-on can fit only by turning. The ends keep their own
+  // shading and are not offset. The covariance loses the width's information (and the part of its
+  // dilation the offset absorbs).
+  bool free_outline_width = false;
   // The model's box (width, depth, height along x_a, y_a, z_a, centred at the antenna frame's
   // origin); outline points more than box_tolerance_m outside it (brackets and mounting parts on
   // the back plate) are not measured: in a photo their outline runs into the arms and clamps that

@@ -67,6 +67,7 @@ struct Sample {
   Eigen::Matrix<double, 1, 6> J;  // d(projection · normal)/d(δ, δt)
   std::uint32_t edge = 0;         // the mesh edge it lies on (correlated errors, see covariance)
   double px_per_m = 0;            // f / depth: image size of a model shape error
+  bool on_long_edge = false;      // on one of the model's long edges: the outline's width
 };
 
 // Outline points of one view, counted: those on the model's box (candidates, of which some fall

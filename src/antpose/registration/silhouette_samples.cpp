@@ -173,7 +173,8 @@ void gather(const EdgeMesh& m, const Pose& pose, const PreparedView& v, const ca
     if (!silhouette) continue;
     const Vec3& a_antenna = m.vertices[e.a];
     const Vec3& b_antenna = m.vertices[e.b];
-    if (const auto long_edge = long_edge_of(a_antenna, b_antenna); long_edge && !o.long_edges[*long_edge]) continue;
+    const auto long_edge = long_edge_of(a_antenna, b_antenna);
+    if (long_edge && !o.long_edges[*long_edge]) continue;
     const int n = static_cast<int>(std::floor((*pm.uv[e.b] - *pm.uv[e.a]).norm() / spacing));
     const Vec3 A = pose.R * a_antenna + pose.t, B = pose.R * b_antenna + pose.t;
     for (int j = 0; j < n; ++j) {
@@ -225,7 +226,8 @@ void gather(const EdgeMesh& m, const Pose& pose, const PreparedView& v, const ca
       const Eigen::Matrix<double, 1, 6> J =
           what.jacobians ? sample_jacobian(d_uv_d_camera, v, pose, X, normal) : Eigen::Matrix<double, 1, 6>::Zero();
       const double depth = (v.R_cb * X + v.t_cb).z();
-      out.push_back({normal, *edge * scale, J, static_cast<std::uint32_t>(ei), 0.5 * (K.fx + K.fy) / depth});
+      out.push_back({normal, *edge * scale, J, static_cast<std::uint32_t>(ei), 0.5 * (K.fx + K.fy) / depth,
+                     long_edge.has_value()});
     }
   }
 }
