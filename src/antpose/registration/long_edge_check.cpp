@@ -48,10 +48,10 @@ std::vector<LongEdgeLeftOut> check_long_edges(const model::Mesh& mesh_antenna, c
     LongEdgeLeftOut& e = out.emplace_back();
     e.edge = edge;
     e.T_board_antenna = refined.T_board_antenna;
-    e.turn_board = log_so3(refined.T_board_antenna.linear() * R_whole.transpose());
-    e.turn_rad = e.turn_board.norm();
-    e.distance = distance(e.turn_board, refined.covariance.topLeftCorner<3, 3>(),
-                          whole.covariance.topLeftCorner<3, 3>(), options.sigma_floor_rad);
+    const Vec3 turn = log_so3(refined.T_board_antenna.linear() * R_whole.transpose());
+    e.turn_rad = turn.norm();
+    e.distance = distance(turn, refined.covariance.topLeftCorner<3, 3>(), whole.covariance.topLeftCorner<3, 3>(),
+                          options.sigma_floor_rad);
     e.disagrees = e.distance > options.max_distance;
     e.samples = refined.samples;
     e.whole_samples = whole.samples;

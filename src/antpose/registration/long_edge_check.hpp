@@ -48,8 +48,7 @@ struct LongEdgeCheckOptions {
 struct LongEdgeLeftOut {
   int edge = 0;                             // long_edge_of's index
   Iso3 T_board_antenna = Iso3::Identity();  // the pose refined without it
-  Vec3 turn_board = Vec3::Zero();           // its rotation from the whole outline's pose, exp(δ) R_whole
-  double turn_rad = 0.0;                    // |δ|
+  double turn_rad = 0.0;                    // its rotation from the whole outline's pose
   double distance = 0.0;                    // the distance of the file comment
   bool disagrees = false;                   // beyond max_distance
   std::size_t samples = 0;                  // outline samples the pose without it used
