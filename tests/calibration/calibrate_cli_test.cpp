@@ -53,6 +53,15 @@ TEST(CalibrateCli, WritesDeviceYamlAndPrintsResiduals) {
   EXPECT_EQ(c2.acc_bias, c.acc_bias);
   EXPECT_EQ(c2.gyro_misalignment, c.gyro_misalignment);
   EXPECT_TRUE(c2.mag_field_uT);
+  // Aligned to the accelerometer just calibrated, with each fit's σ for the compass.
+  EXPECT_NE(c2.mag_alignment, Mat3::Identity());
+  ASSERT_TRUE(c2.mag_alignment_sigma_rad && c2.mag_hard_iron_sigma_uT && c2.mag_soft_iron_sigma);
+  EXPECT_GT(rad2deg(c2.mag_alignment_sigma_rad->minCoeff()), 0.001);
+  EXPECT_LT(rad2deg(c2.mag_alignment_sigma_rad->maxCoeff()), 0.2);
+  EXPECT_GT(c2.mag_hard_iron_sigma_uT->minCoeff(), 0.001);
+  EXPECT_LT(c2.mag_hard_iron_sigma_uT->maxCoeff(), 0.1);
+  EXPECT_GT(c2.mag_soft_iron_sigma->minCoeff(), 1e-5);
+  EXPECT_LT(c2.mag_soft_iron_sigma->maxCoeff(), 1e-2);
 }
 
 TEST(CalibrateCli, TooFewStaticFramesSaysFoundAndNeededAndKeepsOldFile) {

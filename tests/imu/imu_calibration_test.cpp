@@ -18,6 +18,9 @@ TEST(ImuCalibration, RoundTripKeepsValuesAndUnknownKeys) {
   c.mag_hard_iron_uT = Vec3(12.5, -3.25, 40.0000001);
   c.mag_soft_iron << 1.01, 0.02, 0.0, 0.02, 0.98, -0.01, 0.0, -0.01, 1.03;
   c.mag_alignment = exp_so3(deg2rad(1.0) * Vec3(0.17, 0.12, -0.06));
+  c.mag_alignment_sigma_rad = deg2rad(1.0) * Vec3(0.021, 0.018, 0.024);
+  c.mag_hard_iron_sigma_uT = Vec3(0.011, 0.013, 0.012);
+  c.mag_soft_iron_sigma = Mat3::Constant(2e-4);
   c.acc_bias = Vec3(0.05, -0.1, 0.2);
   c.acc_scale = Vec3(1.001, 0.999, 1.0);
   c.gyro_bias = Vec3(1e-3, -2e-3, 3e-3);
@@ -31,6 +34,10 @@ TEST(ImuCalibration, RoundTripKeepsValuesAndUnknownKeys) {
   EXPECT_EQ(r.mag_hard_iron_uT, c.mag_hard_iron_uT);
   EXPECT_EQ(r.mag_soft_iron, c.mag_soft_iron);
   EXPECT_LT((r.mag_alignment - c.mag_alignment).cwiseAbs().maxCoeff(), 1e-15);
+  ASSERT_TRUE(r.mag_alignment_sigma_rad);
+  EXPECT_LT((*r.mag_alignment_sigma_rad - *c.mag_alignment_sigma_rad).cwiseAbs().maxCoeff(), 1e-15);
+  EXPECT_EQ(r.mag_hard_iron_sigma_uT, c.mag_hard_iron_sigma_uT);
+  EXPECT_EQ(r.mag_soft_iron_sigma, c.mag_soft_iron_sigma);
   EXPECT_EQ(r.acc_bias, c.acc_bias);
   EXPECT_EQ(r.acc_scale, c.acc_scale);
   EXPECT_EQ(r.gyro_bias, c.gyro_bias);
@@ -44,6 +51,7 @@ TEST(ImuCalibration, MissingEntriesAreNeutral) {
   EXPECT_EQ(c.mag_hard_iron_uT, Vec3(1, 2, 3));
   EXPECT_EQ(c.mag_soft_iron, Mat3::Identity());
   EXPECT_EQ(c.mag_alignment, Mat3::Identity());
+  EXPECT_FALSE(c.mag_alignment_sigma_rad);
   EXPECT_EQ(c.acc_scale, Vec3::Ones());
   EXPECT_EQ(c.gyro_bias, Vec3::Zero());
 }
@@ -89,6 +97,18 @@ INSTANTIATE_TEST_SUITE_P(
         BadFile{
             "format: antpose-device\nversion: 1\nimu:\n  magnetometer:\n    alignment: [[1,0.1,0],[0,1,0],[0,0,1]]\n",
             "imu.magnetometer.alignment is not a small rotation (RᵀR − I off by 0.14"},
+        BadFile{
+            "format: antpose-device\nversion: 1\nimu:\n  magnetometer:\n    alignment_sigma_deg: [0.02, -0.01, 0.02]\n",
+            "bad.yaml:5: imu.magnetometer.alignment_sigma_deg is (0.02, -0.01, 0.02); expected 1σ per axis in "
+            "degrees, each from 0 to 10"},
+        BadFile{
+            "format: antpose-device\nversion: 1\nimu:\n  magnetometer:\n    hard_iron_sigma_uT: [0.01, 0.01, 500]\n",
+            "bad.yaml:5: imu.magnetometer.hard_iron_sigma_uT is (0.01, 0.01, 500); expected 1σ per axis in µT, "
+            "each from 0 to 100"},
+        BadFile{"format: antpose-device\nversion: 1\nimu:\n  magnetometer:\n"
+                "    soft_iron_sigma: [[0.001, 0.002, 0], [0, 0.001, 0], [0, 0, 0.001]]\n",
+                "bad.yaml:5: imu.magnetometer.soft_iron_sigma has entries from 0 to 0.002; expected a symmetric 3×3 "
+                "of 1σ per soft-iron entry, each from 0 to 1"},
         BadFile{"format: antpose-device\nversion: 1\nimu:\n  magnetometer:\n    hard_iron_uT: [20000, 0, 0]\n",
                 "was it written in nT?"},
         BadFile{"format: antpose-device\nversion: 1\nimu:\n  accelerometer:\n    scale: [9.81, 1, 1]\n",

@@ -163,11 +163,11 @@ TEST(BoardWorld, HeadingFromTheFieldAtThePhotos) {
   // board's attitude (the photos' tilts relative to the board are exact): exp(−δ) B, plus noise.
   std::mt19937_64 rng(7);
   std::normal_distribution<double> g(0.0, 0.01);
-  std::vector<Vec3> fields;
-  for (int i = 0; i < 12; ++i) fields.push_back(exp_so3(-delta) * B_world + Vec3(g(rng), g(rng), g(rng)));
+  std::vector<CompassPhoto> fields;
+  for (int i = 0; i < 12; ++i) fields.push_back({exp_so3(-delta) * B_world + Vec3(g(rng), g(rng), g(rng))});
   CompassOptions options;
   options.calibration_sigma_rad = deg2rad(0.15);
-  const auto r = heading_from_field(board, fields, options);
+  const auto r = heading_from_field(board, fields, std::nullopt, options);
   ASSERT_TRUE(r.compass_turn_rad);
   const Vec3 e = log_so3(R_true * r.R_world_board.transpose());
   std::printf("turn %.3f°, error (%.3f, %.3f, %.3f)°, heading σ %.3f°\n", rad2deg(*r.compass_turn_rad), rad2deg(e.x()),
@@ -184,11 +184,72 @@ TEST(BoardWorld, HeadingFromTheFieldAtThePhotos) {
   EXPECT_NEAR(r.covariance(0, 0), board.covariance(0, 0), 0.01 * board.covariance(0, 0));  // turned by 1.5°
 
   // One field, or none with a horizontal part: the board as it was.
-  const auto one = heading_from_field(board, {fields.front()}, options);
+  const auto one = heading_from_field(board, {fields.front()}, std::nullopt, options);
   EXPECT_FALSE(one.compass_turn_rad);
   EXPECT_TRUE(one.R_world_board.isApprox(board.R_world_board));
-  const auto vertical = heading_from_field(board, std::vector<Vec3>(3, Vec3(0, 0, -40)), options);
+  const auto vertical =
+      heading_from_field(board, std::vector<CompassPhoto>(3, {Vec3(0, 0, -40)}), std::nullopt, options);
   EXPECT_FALSE(vertical.compass_turn_rad);
+}
+
+// The magnetometer calibration's share of the heading σ: its errors (hard iron, soft iron, the
+// axes' turn against the accelerometer's) turn every photo's field, each by its own attitude. Over
+// draws of the errors from the calibration's σ, the compass's turn spreads as the σ it states.
+TEST(BoardWorld, TheCompasssCalibrationSigmaIsTheSpreadOfItsTurnOverTheCalibrationsErrors) {
+  const double dip = deg2rad(62.0);
+  const Vec3 B_world(0.0, 48.0 * std::cos(dip), -48.0 * std::sin(dip));
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> heading(0.0, 2 * M_PI), up(deg2rad(60), deg2rad(110));
+  std::vector<Mat3> R_world_device;  // a phone held upright, turned round a board
+  for (int i = 0; i < 12; ++i)
+    R_world_device.push_back(exp_so3(Vec3(0, 0, heading(rng))) * exp_so3(Vec3(up(rng), 0, 0)));
+  CompassCalibration c;
+  c.soft_iron << 1.01, 0.01, -0.005, 0.01, 0.99, 0.008, -0.005, 0.008, 1.0;
+  c.soft_iron /= std::cbrt(c.soft_iron.determinant());
+  c.alignment = exp_so3(deg2rad(1.0) * Vec3(0.2, -0.15, 0.06));
+  c.hard_iron_sigma_uT = Vec3(0.012, 0.015, 0.01);
+  c.soft_iron_sigma << 3e-4, 2e-4, 2e-4, 2e-4, 3e-4, 2e-4, 2e-4, 2e-4, 3e-4;
+  c.alignment_sigma_rad = deg2rad(1.0) * Vec3(0.02, 0.03, 0.025);
+  const Vec3 b_true(1.5, -2.0, 2.5);
+  // Each photo's raw field, and that field as a calibration off by (δb, δS, δ) turns it into the world.
+  const auto photos = [&](const Vec3& db, const Mat3& dS, const Vec3& delta) {
+    std::vector<CompassPhoto> p;
+    for (const Mat3& R : R_world_device) {
+      const Vec3 raw = (c.alignment * c.soft_iron).inverse() * R.transpose() * B_world + b_true;
+      p.push_back({R * exp_so3(delta) * c.alignment * (c.soft_iron + dS) * (raw - b_true - db), R});
+    }
+    return p;
+  };
+  BoardWorldAttitude board;  // exact, so that only the calibration is left in the heading's σ
+  const auto exact = heading_from_field(board, photos(Vec3::Zero(), Mat3::Zero(), Vec3::Zero()), c, {});
+  ASSERT_TRUE(exact.compass_turn_rad);
+  const double stated = std::sqrt(exact.covariance(2, 2));
+  std::normal_distribution<double> g(0.0, 1.0);
+  double sum2 = 0.0;
+  const int draws = 2000;
+  for (int k = 0; k < draws; ++k) {
+    const Vec3 db = c.hard_iron_sigma_uT.cwiseProduct(Vec3(g(rng), g(rng), g(rng)));
+    Mat3 dS;
+    for (int r = 0; r < 3; ++r)
+      for (int col = r; col < 3; ++col) dS(r, col) = dS(col, r) = c.soft_iron_sigma(r, col) * g(rng);
+    const Vec3 delta = c.alignment_sigma_rad.cwiseProduct(Vec3(g(rng), g(rng), g(rng)));
+    const double turn = *heading_from_field(board, photos(db, dS, delta), c, {}).compass_turn_rad;
+    sum2 += turn * turn;
+  }
+  const double spread = std::sqrt(sum2 / draws);
+  std::printf("stated %.4f°, spread over %d draws %.4f°\n", rad2deg(stated), draws, rad2deg(spread));
+  EXPECT_NEAR(stated / spread, 1.0, 0.07);  // 2000 draws: the spread's own 1σ is 1.6 %, the σ's sampling 2 %
+  // Each part alone is smaller: the hard iron's 0.015 µT over a 22.5 µT horizontal field is 0.04°.
+  CompassCalibration alignment_only = c;
+  alignment_only.hard_iron_sigma_uT.setZero(), alignment_only.soft_iron_sigma.setZero();
+  const auto part = heading_from_field(board, photos(Vec3::Zero(), Mat3::Zero(), Vec3::Zero()), alignment_only, {});
+  EXPECT_LT(part.covariance(2, 2), 0.8 * exact.covariance(2, 2));
+  // Without the calibration's σ: the fallback prior.
+  CompassOptions fallback;
+  fallback.calibration_sigma_rad = deg2rad(0.15);
+  const auto prior =
+      heading_from_field(board, photos(Vec3::Zero(), Mat3::Zero(), Vec3::Zero()), std::nullopt, fallback);
+  EXPECT_NEAR(rad2deg(std::sqrt(prior.covariance(2, 2))), 0.15, 1e-9);
 }
 
 TEST(AntennaAttitude, ComposesBoardAndRegistrationWithTrueNorth) {

@@ -94,7 +94,10 @@ CalibrateImuResult calibrate_imu(const Capture& capture, const CalibrateImuOptio
       cal.mag_soft_iron = r.magnetometer->soft_iron;
       cal.mag_field_uT = r.magnetometer->field_uT;
       cal.mag_residual_rel = r.magnetometer->residual_rel;
+      cal.mag_hard_iron_sigma_uT = r.magnetometer->hard_iron_sigma_uT;
+      cal.mag_soft_iron_sigma = r.magnetometer->soft_iron_sigma;
       cal.mag_alignment = Mat3::Identity();
+      cal.mag_alignment_sigma_rad.reset();
       if (!cal.acc_residual_rms_m_s2 || !capture.streams.count(std::string(streams::kAccelerometer))) {
         diagnostics.warn(source, 0,
                          "the magnetometer's axes were not aligned to the accelerometer's (no accelerometer "
@@ -110,6 +113,7 @@ CalibrateImuResult calibrate_imu(const Capture& capture, const CalibrateImuOptio
                                                                 corrected.require(streams::kMagnetometer), r.gravity,
                                                                 o.magnetometer_alignment_options, source);
           cal.mag_alignment = r.magnetometer_alignment->R_calibrated_magnetometer;
+          cal.mag_alignment_sigma_rad = r.magnetometer_alignment->sigma_rad;
         } catch (const MeasurementError& e) {
           diagnostics.warn(source, 0,
                            fmt::format("{}; the magnetometer's axes are taken as the accelerometer's", e.what()));
@@ -119,6 +123,7 @@ CalibrateImuResult calibrate_imu(const Capture& capture, const CalibrateImuOptio
       r.hard_iron = imu::estimate_hard_iron(mag, {}, source);
       cal.mag_hard_iron_uT = r.hard_iron->hard_iron_uT;
       cal.mag_soft_iron = Mat3::Identity();
+      cal.mag_hard_iron_sigma_uT.reset(), cal.mag_soft_iron_sigma.reset(), cal.mag_alignment_sigma_rad.reset();
       cal.mag_field_uT = r.hard_iron->field_uT;
       cal.mag_residual_rel = r.hard_iron->radius_spread;
     }

@@ -45,6 +45,36 @@ struct EllipsoidResidual {
   Vec3 m_;
 };
 
+// The 1σ of b and of the normalised S = S_s / ∛det S_s from the refinement's covariance: S_s's
+// scale does not change the residual (F carries it), one null direction left out of the inverse;
+// dS = (dS_s − ⅓ tr(S_s⁻¹ dS_s) S_s) / ∛det S_s takes s's covariance to S's entries.
+void refinement_sigmas(MagnetometerCalibration& c, ceres::Problem& problem, const double* b, const double* s,
+                       const Mat3& S_s, double variance) {
+  ceres::Covariance::Options co;
+  co.algorithm_type = ceres::DENSE_SVD;
+  co.null_space_rank = 1;
+  ceres::Covariance covariance(co);
+  if (!covariance.Compute({{b, b}, {s, s}}, &problem)) return;
+  Mat3 cov_b;
+  Eigen::Matrix<double, 6, 6, Eigen::RowMajor> cov_s;
+  covariance.GetCovarianceBlock(b, b, cov_b.data());
+  covariance.GetCovarianceBlock(s, s, cov_s.data());
+  constexpr int kRow[6] = {0, 0, 0, 1, 1, 2}, kCol[6] = {0, 1, 2, 1, 2, 2};
+  const Mat3 S_inv = S_s.inverse();
+  const double root = std::cbrt(S_s.determinant());
+  Eigen::Matrix<double, 6, 6> J;
+  for (int k = 0; k < 6; ++k) {
+    const double trace = (kRow[k] == kCol[k] ? 1.0 : 2.0) * S_inv(kRow[k], kCol[k]);  // tr(S_s⁻¹ ∂S_s/∂s_k)
+    for (int j = 0; j < 6; ++j) J(j, k) = ((j == k ? 1.0 : 0.0) - trace * S_s(kRow[j], kCol[j]) / 3.0) / root;
+  }
+  const Eigen::Matrix<double, 6, 6> cov_n = J * cov_s * J.transpose();
+  c.hard_iron_sigma_uT = (variance * cov_b.diagonal()).cwiseMax(0.0).cwiseSqrt();
+  Mat3 sigma;
+  for (int k = 0; k < 6; ++k)
+    sigma(kRow[k], kCol[k]) = sigma(kCol[k], kRow[k]) = std::sqrt(std::max(0.0, variance * cov_n(k, k)));
+  c.soft_iron_sigma = sigma;
+}
+
 // Index of the nearest of the 26 directions (±1, 0)³ \ 0.
 // â · R m̂ − c, R = exp(w).
 struct DotProductResidual {
@@ -185,6 +215,8 @@ MagnetometerCalibration fit_magnetometer(const Stream& stream, const Magnetomete
       const Eigen::SelfAdjointEigenSolver<Mat3> eS(c.soft_iron);
       c.semi_axes_uT = (c.field_uT * eS.eigenvalues().cwiseInverse());
       std::sort(c.semi_axes_uT.data(), c.semi_axes_uT.data() + 3);
+      const double variance = 2.0 * summary.final_cost / std::max(1.0, static_cast<double>(m.size()) - 10.0);
+      refinement_sigmas(c, problem, b, s, S, variance);
     }
   }
   double ss = 0.0;

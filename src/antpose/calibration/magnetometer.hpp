@@ -12,11 +12,13 @@
 //     semi-axes, so det S = 1 (S changes the shape, not the volume) and ‖S (m − b)‖ = F, the
 //     fitted field strength.
 //  3. Optional Ceres (LM) refinement of the geometric residual ‖S (m − b)‖ − F over b, the 6
-//     entries of a symmetric S (normalised to det S = 1) and F.
+//     entries of a symmetric S (normalised to det S = 1) and F, with the covariance of b and S
+//     (the compass's calibration error, measure::heading_from_field).
 // The thesis's hard iron (max + min)/2 is imu::estimate_hard_iron.
 #pragma once
 
 #include <cstddef>
+#include <optional>
 #include <string>
 
 #include "antpose/core/error.hpp"
@@ -45,6 +47,10 @@ struct MagnetometerCalibration {
   double residual_rel = 0.0;            // std(‖S(m − b)‖) / F
   double residual_rms_uT = 0.0;         // RMS(‖S(m − b)‖ − F)
   Vec3 max_min_hard_iron_uT = Vec3::Zero();  // (max + min)/2, for comparison
+  /// 1σ of b (µT) and of each entry of S (symmetric), from the refinement's covariance scaled by
+  /// its residuals' variance (S's scale, which F carries, left out); none without step 3.
+  std::optional<Vec3> hard_iron_sigma_uT;
+  std::optional<Mat3> soft_iron_sigma;
 
   Vec3 correct(const Vec3& raw) const { return soft_iron * (raw - hard_iron_uT); }
 };

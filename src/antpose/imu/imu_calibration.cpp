@@ -112,6 +112,33 @@ ImuCalibration parse_imu_calibration(const std::string& text, const fs::path& fi
       // Rounded entries (a file written by hand): the nearest rotation.
       c.mag_alignment = nearest_rotation(c.mag_alignment);
     }
+    if (mag["hard_iron_sigma_uT"]) {
+      const Vec3 sigma = vec3(mag["hard_iron_sigma_uT"], file, "imu.magnetometer.hard_iron_sigma_uT");
+      if (!(sigma.minCoeff() >= 0.0 && sigma.maxCoeff() < 100.0))
+        throw InputError(file, line_of(mag["hard_iron_sigma_uT"]),
+                         fmt::format("imu.magnetometer.hard_iron_sigma_uT is ({:.3g}, {:.3g}, {:.3g}); expected "
+                                     "1σ per axis in µT, each from 0 to 100",
+                                     sigma.x(), sigma.y(), sigma.z()));
+      c.mag_hard_iron_sigma_uT = sigma;
+    }
+    if (mag["soft_iron_sigma"]) {
+      const Mat3 sigma = mat3(mag["soft_iron_sigma"], file, "imu.magnetometer.soft_iron_sigma");
+      if (!(sigma.minCoeff() >= 0.0 && sigma.maxCoeff() < 1.0) || !sigma.isApprox(sigma.transpose(), 1e-9))
+        throw InputError(file, line_of(mag["soft_iron_sigma"]),
+                         fmt::format("imu.magnetometer.soft_iron_sigma has entries from {:.3g} to {:.3g}; expected "
+                                     "a symmetric 3×3 of 1σ per soft-iron entry, each from 0 to 1",
+                                     sigma.minCoeff(), sigma.maxCoeff()));
+      c.mag_soft_iron_sigma = sigma;
+    }
+    if (mag["alignment_sigma_deg"]) {
+      const Vec3 sigma = vec3(mag["alignment_sigma_deg"], file, "imu.magnetometer.alignment_sigma_deg");
+      if (!(sigma.minCoeff() >= 0.0 && sigma.maxCoeff() < 10.0))
+        throw InputError(file, line_of(mag["alignment_sigma_deg"]),
+                         fmt::format("imu.magnetometer.alignment_sigma_deg is ({:.3g}, {:.3g}, {:.3g}); expected "
+                                     "1σ per axis in degrees, each from 0 to 10",
+                                     sigma.x(), sigma.y(), sigma.z()));
+      c.mag_alignment_sigma_rad = deg2rad(1.0) * sigma;
+    }
   }
   if (const auto acc = section(imu, "accelerometer", file, "imu.accelerometer")) {
     if (acc["bias_m_s2"]) c.acc_bias = vec3(acc["bias_m_s2"], file, "imu.accelerometer.bias_m_s2");
@@ -153,6 +180,18 @@ std::string format_imu_calibration(const ImuCalibration& c) {
     imu["magnetometer"]["hard_iron_uT"] = flow_vector(c.mag_hard_iron_uT);
     imu["magnetometer"]["soft_iron"] = flow_matrix(c.mag_soft_iron);
     if (c.mag_alignment != Mat3::Identity()) imu["magnetometer"]["alignment"] = flow_matrix(c.mag_alignment);
+    // σ keys are written with their fit and dropped without it, so that a refit never keeps an old σ.
+    const auto sigma = [&](const char* key, const auto& value, const auto& flow) {
+      if (value)
+        imu["magnetometer"][key] = flow(*value);
+      else
+        imu["magnetometer"].remove(key);
+    };
+    sigma("hard_iron_sigma_uT", c.mag_hard_iron_sigma_uT, flow_vector);
+    sigma("soft_iron_sigma", c.mag_soft_iron_sigma, flow_matrix);
+    sigma("alignment_sigma_deg",
+          c.mag_alignment_sigma_rad ? std::optional<Vec3>(rad2deg(1.0) * *c.mag_alignment_sigma_rad) : std::nullopt,
+          flow_vector);
     if (c.mag_field_uT) imu["magnetometer"]["field_uT"] = io::format_number(*c.mag_field_uT);
     if (c.mag_residual_rel) imu["magnetometer"]["residual_rel"] = io::format_number(*c.mag_residual_rel);
   }

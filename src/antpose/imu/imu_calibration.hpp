@@ -48,6 +48,12 @@ struct ImuCalibration {
   /// R_calibrated_magnetometer: the corrected field from the magnetometer's axes into the
   /// calibrated (accelerometer) frame (calibration::fit_magnetometer_alignment).
   Mat3 mag_alignment = Mat3::Identity();
+  /// 1σ of the hard iron (µT), of each soft-iron entry, and per axis of mag_alignment's rotation
+  /// vector (rad), as the fits measured them: the compass's calibration error, which
+  /// measure::heading_from_field carries to the heading.
+  std::optional<Vec3> mag_hard_iron_sigma_uT;
+  std::optional<Mat3> mag_soft_iron_sigma;
+  std::optional<Vec3> mag_alignment_sigma_rad;
   Vec3 acc_bias = Vec3::Zero();   // m/s²
   Vec3 acc_scale = Vec3::Ones();
   Mat3 acc_misalignment = Mat3::Identity();  // T_a, unit diagonal

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <random>
 
 #include <Eigen/Eigenvalues>
 #include <fmt/format.h>
@@ -162,14 +163,65 @@ BoardWorldAttitude board_world_attitude(const std::vector<BoardPhoto>& photos,
   return out;
 }
 
-BoardWorldAttitude heading_from_field(BoardWorldAttitude board, const std::vector<Vec3>& field_world_uT,
-                                      const CompassOptions& o) {
+namespace {
+
+// σ_cal (heading_from_field). Each photo's heading change is linear in the calibration's errors
+// e = (δb, the 6 entries of δS, δ), row g_i; the compass takes their median, which is not linear
+// in e (the photo in the middle changes with e's direction), so its spread is sampled over draws
+// of e: a fixed generator, so that a capture's σ is reproducible; 1000 draws leave it within
+// about 2 %.
+double compass_calibration_sigma(const std::vector<CompassPhoto>& photos, const CompassCalibration& c) {
+  using Row = Eigen::Matrix<double, 1, 12>;
+  constexpr int kRow[6] = {0, 0, 0, 1, 1, 2}, kCol[6] = {0, 1, 2, 1, 2, 2};
+  const Mat3 unwarp = (c.alignment * c.soft_iron).inverse();
+  std::vector<Row> g;
+  for (const auto& p : photos) {
+    const Vec3& b = p.field_world_uT;
+    const double h2 = b.head<2>().squaredNorm();
+    if (!(h2 > 0.0)) continue;
+    const Eigen::RowVector3d dpsi = Eigen::RowVector3d(b.y() / h2, -b.x() / h2, 0.0) * p.R_world_device;
+    const Vec3 m = p.R_world_device.transpose() * b, u = unwarp * m;
+    Row row;
+    row.head<3>() = dpsi * (-c.alignment * c.soft_iron);
+    for (int k = 0; k < 6; ++k) {
+      Mat3 E = Mat3::Zero();
+      E(kRow[k], kCol[k]) = E(kCol[k], kRow[k]) = 1.0;
+      row(3 + k) = dpsi * (c.alignment * E * u);
+    }
+    row.tail<3>() = dpsi * (-skew(m));
+    g.push_back(row);
+  }
+  if (g.empty()) return 0.0;
+  Eigen::Matrix<double, 12, 1> sigma;
+  sigma << c.hard_iron_sigma_uT, c.soft_iron_sigma(0, 0), c.soft_iron_sigma(0, 1), c.soft_iron_sigma(0, 2),
+      c.soft_iron_sigma(1, 1), c.soft_iron_sigma(1, 2), c.soft_iron_sigma(2, 2), c.alignment_sigma_rad;
+  std::mt19937_64 rng(1);
+  std::normal_distribution<double> unit(0.0, 1.0);
+  constexpr int kDraws = 1000;
+  double sum2 = 0.0;
+  std::vector<double> turns(g.size());
+  for (int k = 0; k < kDraws; ++k) {
+    Eigen::Matrix<double, 12, 1> e;
+    for (int i = 0; i < 12; ++i) e(i) = sigma(i) * unit(rng);
+    for (std::size_t i = 0; i < g.size(); ++i) turns[i] = g[i] * e;
+    const double m = median(turns);
+    sum2 += m * m;
+  }
+  return std::sqrt(sum2 / kDraws);
+}
+
+}  // namespace
+
+BoardWorldAttitude heading_from_field(BoardWorldAttitude board, const std::vector<CompassPhoto>& photos,
+                                      const std::optional<CompassCalibration>& calibration, const CompassOptions& o) {
   std::vector<double> east_of_north;  // rad, clockwise from +y
+  std::vector<CompassPhoto> used;
   Vec3 mean = Vec3::Zero();
-  for (const Vec3& b : field_world_uT)
-    if (b.head<2>().norm() > 1e-6 * b.norm()) {
+  for (const auto& p : photos)
+    if (const Vec3& b = p.field_world_uT; b.head<2>().norm() > 1e-6 * b.norm()) {
       east_of_north.push_back(std::atan2(b.x(), b.y()));
       mean += b / b.norm();
+      used.push_back(p);
     }
   const auto n = east_of_north.size();
   if (n < o.min_photos || n == 0) return board;
@@ -182,6 +234,8 @@ BoardWorldAttitude heading_from_field(BoardWorldAttitude board, const std::vecto
   for (const double a : east_of_north) residuals.push_back(wrap_pi(a - turn));
   const double scatter_of_median =
       n > 1 ? robust_sigma(std::move(residuals)) * std::sqrt(M_PI / 2 / static_cast<double>(n)) : 0.0;
+  const double calibration_sigma =
+      calibration ? compass_calibration_sigma(used, *calibration) : o.calibration_sigma_rad;
 
   const Mat3 R_turn = exp_so3(Vec3(0.0, 0.0, turn));
   const Vec3 b = R_turn * mean;
@@ -192,7 +246,7 @@ BoardWorldAttitude heading_from_field(BoardWorldAttitude board, const std::vecto
   board.R_world_board = R_turn * board.R_world_board;
   const Mat3 turned = R_turn * board.covariance * R_turn.transpose();
   board.covariance = A * turned * A.transpose();
-  board.covariance(2, 2) += o.calibration_sigma_rad * o.calibration_sigma_rad + scatter_of_median * scatter_of_median;
+  board.covariance(2, 2) += calibration_sigma * calibration_sigma + scatter_of_median * scatter_of_median;
   board.compass_turn_rad = turn;
   return board;
 }

@@ -35,10 +35,23 @@ struct BoardPhoto {
   Mat3 cov_R_camera_board = Mat3::Zero();  // rad², camera frame
 };
 
+/// A magnetometer calibration (imu::ImuCalibration: m = A S (m_raw − b)) with the 1σ of its
+/// parameters, each taken as independent.
+struct CompassCalibration {
+  Mat3 soft_iron = Mat3::Identity();  // S, det 1
+  Mat3 alignment = Mat3::Identity();  // A = R_calibrated_magnetometer
+  Vec3 hard_iron_sigma_uT = Vec3::Zero();
+  Mat3 soft_iron_sigma = Mat3::Zero();      // per entry of S (symmetric)
+  Vec3 alignment_sigma_rad = Vec3::Zero();  // per axis of A's rotation vector
+};
+
 struct CameraImu {
   Mat3 R_device_camera = Mat3::Identity();
   Mat3 covariance = Mat3::Zero();  // rad², device frame
   double time_offset_s = 0.0;
+  /// The compass's calibration and its σ; none: the profile does not say
+  /// (CompassOptions::calibration_sigma_rad).
+  std::optional<CompassCalibration> compass;
 };
 
 struct BoardWorldOptions {
@@ -78,28 +91,42 @@ BoardWorldAttitude board_world_attitude(const std::vector<BoardPhoto>& photos,
                                         const BoardWorldOptions& options, Diagnostics& diagnostics);
 
 struct CompassOptions {
-  /// 1σ heading error of a calibrated magnetometer's field direction (hard- and soft-iron
-  /// residuals), rad. On a simulated calibrated typical phone (aligned to its accelerometer) the
-  /// calibrated field at the photos, turned into the world by the true attitudes, pointed −0.02°
-  /// to +0.13° off magnetic north.
+  /// 1σ heading error of a magnetometer calibration whose profile holds no σ of its own (written
+  /// by another tool, or before antpose wrote them), rad. On simulated typical phones the
+  /// calibrated field at photo attitudes pointed about 0.15° RMS off magnetic north where the
+  /// magnetometer's axes were not aligned to the accelerometer's (0.12° a phone, 0.11° more a
+  /// site), 0.05° where they were.
   double calibration_sigma_rad = deg2rad(0.15);
   std::size_t min_photos = 2;
 };
 
+/// One photo's compass: the calibrated field in the world frame through that photo's attitude
+/// from the board (field_at_photos, field_check.hpp), and that attitude.
+struct CompassPhoto {
+  Vec3 field_world_uT = Vec3::Zero();
+  Mat3 R_world_device = Mat3::Identity();
+};
+
 /// The board's heading from the compass at the photos rather than from the orientation track.
-/// `field_world_uT` is the field at each photo in the world frame through that photo's attitude
-/// from the board (field_at_photos, field_check.hpp): where the board's heading is right, its
-/// horizontal part points to magnetic north (+y). The board is turned about the vertical by the
-/// median of the photos' horizontal field directions. While walking, the track's heading carries
-/// its tilt errors through the dip (a 1° tilt error turns a compass by tan(dip)°), and smoothing
-/// spreads them over the capture: on simulated walks its heading at the photos was 0.2–1.4° off
-/// though the calibrated field there pointed within 0.1° of north (docs/non-contact.md). Here each
-/// photo's tilt is the board's, so only the board's own tilt error e reaches the heading:
+/// Where the board's heading is right, each field's horizontal part points to magnetic north
+/// (+y). The board is turned about the vertical by the median of the photos' horizontal field
+/// directions. While walking, the track's heading carries its tilt errors through the dip (a 1°
+/// tilt error turns a compass by tan(dip)°), and smoothing spreads them over the capture: on
+/// simulated walks its heading at the photos was 0.2–1.4° off though the calibrated field there
+/// pointed within 0.1° of north. Here each photo's tilt is the board's, so only the board's own
+/// tilt error e reaches the heading:
 ///   e'_z = −tan(dip) (ĥ · e),   ĥ the field's horizontal direction (world),
 /// and the covariance becomes A Σ Aᵀ + (σ_cal² + (π/2) s²/n) ẑẑᵀ, A mapping e to e' and s the
-/// robust scale of the photos' field directions about their median. Fewer than options.min_photos
-/// fields, or a field without a horizontal part: the board is returned unchanged.
-BoardWorldAttitude heading_from_field(BoardWorldAttitude board, const std::vector<Vec3>& field_world_uT,
+/// robust scale of the photos' field directions about their median. σ_cal is the magnetometer
+/// calibration's, common to the photos: its errors (δb, δS, and A's turn δ, device frame) change
+/// photo i's calibrated field m_i = R_iᵀ b_i by
+///   δm_i = A (δS u_i − S δb) + δ × m_i,   u_i = S⁻¹ A⁻¹ m_i = m_raw − b,
+/// and its heading ψ_i = atan2(b_x, b_y) by (b_y, −b_x, 0) / |b_h|² · R_i δm_i; σ_cal is the
+/// spread of their median over the calibration's errors (sampled: the median is not linear in
+/// them). Without the calibration's σ, options.calibration_sigma_rad. Fewer than
+/// options.min_photos fields, or a field without a horizontal part: the board is returned unchanged.
+BoardWorldAttitude heading_from_field(BoardWorldAttitude board, const std::vector<CompassPhoto>& photos,
+                                      const std::optional<CompassCalibration>& calibration,
                                       const CompassOptions& options);
 
 /// The geodesic L1 median of rotations (Weiszfeld), started from their chordal mean.
