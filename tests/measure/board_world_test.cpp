@@ -4,10 +4,13 @@
 #include <cstdio>
 #include <random>
 
+#include <Eigen/SVD>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "antpose/calibration/calibrate_imu.hpp"
 #include "antpose/measure/antenna_attitude.hpp"
+#include "antpose/sim/imu_simulator.hpp"
 
 namespace antpose::measure {
 namespace {
@@ -250,6 +253,59 @@ TEST(BoardWorld, TheCompasssCalibrationSigmaIsTheSpreadOfItsTurnOverTheCalibrati
   const auto prior =
       heading_from_field(board, photos(Vec3::Zero(), Mat3::Zero(), Vec3::Zero()), std::nullopt, fallback);
   EXPECT_NEAR(rad2deg(std::sqrt(prior.covariance(2, 2))), 0.15, 1e-9);
+}
+
+// The same σ against what a calibration leaves: phones drawn within a typical phone's tolerances,
+// each calibrated as `calibrate imu` does (18 held poses, then a tumble), photographed upright
+// round a board. The heading the compass gives the board, against the truth, over the σ it states.
+TEST(BoardWorld, TheCompasssCalibrationSigmaCoversWhatCalibratedPhonesLeave) {
+  const Vec3 B_world(0.0, 24.0, -41.569219381653056);  // the simulator's field: magnetic north, dip 60°
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> heading(0.0, 2 * M_PI), up(deg2rad(60), deg2rad(115)), roll(-0.17, 0.17);
+  std::vector<double> z;
+  for (int phone = 0; phone < 8; ++phone) {
+    sim::ImuSimulation sim;
+    sim.phone = sim::PhoneModel::random(rng);
+    sim.kind = "imu-calibration";
+    sim.trajectory = sim::static_poses(sim::calibration_poses(), 3.0, 2.0);
+    Diagnostics d;
+    calibration::CalibrateImuOptions held;
+    held.magnetometer = false;
+    const auto base = calibration::calibrate_imu(sim::simulate_imu(sim), held, d, "poses").calibration;
+    sim.trajectory = sim::tumble(40.0, 1.5, 100 + phone);
+    calibration::CalibrateImuOptions turned;
+    turned.accelerometer = turned.gyroscope = false;
+    const auto cal = calibration::calibrate_imu(sim::simulate_imu(sim), turned, d, "tumble", base).calibration;
+    ASSERT_TRUE(cal.mag_hard_iron_sigma_uT && cal.mag_soft_iron_sigma && cal.mag_alignment_sigma_rad);
+    const CompassCalibration compass{cal.mag_soft_iron, cal.mag_alignment, *cal.mag_hard_iron_sigma_uT,
+                                     *cal.mag_soft_iron_sigma, *cal.mag_alignment_sigma_rad};
+    // The calibrated frame: the accelerometer's corrected axes (their rotation part), which the
+    // camera's calibration refers to.
+    const Mat3 C =
+        cal.acc_correction() * sim.phone.accelerometer.misalignment * sim.phone.accelerometer.scale.asDiagonal();
+    const Eigen::JacobiSVD<Mat3> svd(C, Eigen::ComputeFullU | Eigen::ComputeFullV);
+    const Mat3 R_calibrated_device = svd.matrixU() * svd.matrixV().transpose();
+    for (int site = 0; site < 10; ++site) {
+      std::vector<CompassPhoto> photos;
+      for (int i = 0; i < 12; ++i) {
+        const Mat3 R_world_device =
+            exp_so3(Vec3(0, 0, heading(rng))) * exp_so3(Vec3(up(rng), 0, 0)) * exp_so3(Vec3(0, roll(rng), 0));
+        const Vec3 raw = sim.phone.magnetometer.apply(R_world_device.transpose() * B_world);
+        const Mat3 R_world_calibrated = R_world_device * R_calibrated_device.transpose();
+        photos.push_back({R_world_calibrated * cal.correct_mag(raw), R_world_calibrated});
+      }
+      const auto board = heading_from_field({}, photos, compass, {});
+      ASSERT_TRUE(board.compass_turn_rad);
+      z.push_back(*board.compass_turn_rad / std::sqrt(board.covariance(2, 2)));
+    }
+  }
+  double sum2 = 0.0, largest = 0.0;
+  for (double v : z) sum2 += v * v, largest = std::max(largest, std::abs(v));
+  const double rms = std::sqrt(sum2 / static_cast<double>(z.size()));
+  std::printf("RMS(error/σ) %.2f over %zu phone-sites, largest |error/σ| %.2f\n", rms, z.size(), largest);
+  EXPECT_GT(rms, 0.6);
+  EXPECT_LT(rms, 1.5);
+  EXPECT_LT(largest, 4.0);
 }
 
 TEST(AntennaAttitude, ComposesBoardAndRegistrationWithTrueNorth) {
