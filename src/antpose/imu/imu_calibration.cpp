@@ -48,6 +48,17 @@ Mat3 misalignment(const YAML::Node& node, const fs::path& file, const std::strin
   return T;
 }
 
+// A 1σ per axis: each entry from 0 to `limit`, in `unit`.
+Vec3 sigma_per_axis(const YAML::Node& node, const fs::path& file, const std::string& key, const char* unit,
+                    double limit) {
+  const Vec3 sigma = vec3(node, file, key);
+  if (!(sigma.minCoeff() >= 0.0 && sigma.maxCoeff() < limit))
+    throw InputError(file, line_of(node),
+                     fmt::format("{} is ({:.3g}, {:.3g}, {:.3g}); expected 1σ per axis in {}, each from 0 to {:g}", key,
+                                 sigma.x(), sigma.y(), sigma.z(), unit, limit));
+  return sigma;
+}
+
 YAML::Node flow_vector(const Vec3& v) { return io::yaml_flow_vector(v); }
 YAML::Node flow_matrix(const Mat3& M) { return io::yaml_flow_matrix(M); }
 
@@ -112,15 +123,9 @@ ImuCalibration parse_imu_calibration(const std::string& text, const fs::path& fi
       // Rounded entries (a file written by hand): the nearest rotation.
       c.mag_alignment = nearest_rotation(c.mag_alignment);
     }
-    if (mag["hard_iron_sigma_uT"]) {
-      const Vec3 sigma = vec3(mag["hard_iron_sigma_uT"], file, "imu.magnetometer.hard_iron_sigma_uT");
-      if (!(sigma.minCoeff() >= 0.0 && sigma.maxCoeff() < 100.0))
-        throw InputError(file, line_of(mag["hard_iron_sigma_uT"]),
-                         fmt::format("imu.magnetometer.hard_iron_sigma_uT is ({:.3g}, {:.3g}, {:.3g}); expected "
-                                     "1σ per axis in µT, each from 0 to 100",
-                                     sigma.x(), sigma.y(), sigma.z()));
-      c.mag_hard_iron_sigma_uT = sigma;
-    }
+    if (mag["hard_iron_sigma_uT"])
+      c.mag_hard_iron_sigma_uT =
+          sigma_per_axis(mag["hard_iron_sigma_uT"], file, "imu.magnetometer.hard_iron_sigma_uT", "µT", 100.0);
     if (mag["soft_iron_sigma"]) {
       const Mat3 sigma = mat3(mag["soft_iron_sigma"], file, "imu.magnetometer.soft_iron_sigma");
       if (!(sigma.minCoeff() >= 0.0 && sigma.maxCoeff() < 1.0) || !sigma.isApprox(sigma.transpose(), 1e-9))
@@ -130,15 +135,10 @@ ImuCalibration parse_imu_calibration(const std::string& text, const fs::path& fi
                                      sigma.minCoeff(), sigma.maxCoeff()));
       c.mag_soft_iron_sigma = sigma;
     }
-    if (mag["alignment_sigma_deg"]) {
-      const Vec3 sigma = vec3(mag["alignment_sigma_deg"], file, "imu.magnetometer.alignment_sigma_deg");
-      if (!(sigma.minCoeff() >= 0.0 && sigma.maxCoeff() < 10.0))
-        throw InputError(file, line_of(mag["alignment_sigma_deg"]),
-                         fmt::format("imu.magnetometer.alignment_sigma_deg is ({:.3g}, {:.3g}, {:.3g}); expected "
-                                     "1σ per axis in degrees, each from 0 to 10",
-                                     sigma.x(), sigma.y(), sigma.z()));
-      c.mag_alignment_sigma_rad = deg2rad(1.0) * sigma;
-    }
+    if (mag["alignment_sigma_deg"])
+      c.mag_alignment_sigma_rad =
+          deg2rad(1.0) *
+          sigma_per_axis(mag["alignment_sigma_deg"], file, "imu.magnetometer.alignment_sigma_deg", "degrees", 10.0);
   }
   if (const auto acc = section(imu, "accelerometer", file, "imu.accelerometer")) {
     if (acc["bias_m_s2"]) c.acc_bias = vec3(acc["bias_m_s2"], file, "imu.accelerometer.bias_m_s2");
