@@ -10,6 +10,7 @@
 #include "antpose/camera/board_pose.hpp"
 #include "antpose/model/box_file.hpp"
 #include "antpose/model/sampling.hpp"
+#include "antpose/sim/antenna_scene.hpp"
 #include "registration/panel_scene.hpp"
 
 namespace antpose::registration {
@@ -345,6 +346,47 @@ TEST(RegisterAntenna, AnAnswerMeetingTooLittleOfItsOutlineIsNone) {
 
   o.max_answer_outline_score = 0.5 * o.max_outline_score;
   EXPECT_FALSE(o.Check().ok()) << "an answer's limit under the clear outline's";
+}
+
+// A pipe where the panel should be: the panel's model fits it about as well at every turn about
+// its long axis. Met clearly, the σ covers the turns; met only faintly, nothing shows that the
+// object is a panel at all (a mast, a mount's pipe), and the answer is none.
+TEST(RegisterAntenna, AFaintAnswerThatShowsNoFacesIsNone) {
+  const model::PanelSpec panel;
+  fixture::SceneSpec spec;
+  spec.rendered = sim::cylinder_mesh(Vec3(0, 0, -0.5 * panel.height_m), Vec3(0, 0, 0.5 * panel.height_m),
+                                     0.25 * (panel.width_m + panel.depth_m), 32);
+  const SyntheticScene s = make_scene(spec);
+  AntennaScene scene = antenna_scene_with_mast(s, panel);
+  std::vector<Vec3> viewpoints;
+  for (const Vec3& c : scene.viewpoints_board) viewpoints.push_back(s.T_board_antenna.inverse() * c);
+  scene.points_board = transformed(model::visible_surface(spec.rendered, viewpoints, 0.02, 5), s.T_board_antenna);
+
+  const auto model = model::parametric_panel(panel);
+  const auto clear = register_antenna(model, scene, {});
+  ASSERT_TRUE(clear.found) << clear.why_not;
+  double open = 0.0;
+  for (const Iso3& T : clear.rivals) {
+    const double angle = angle_between(T.linear().col(1), clear.T_board_antenna.linear().col(1));
+    open = std::max(open, std::min(angle, M_PI - angle));
+  }
+  ASSERT_GT(rad2deg(open), 45.0) << "the pipe must leave the panel's facing open";
+
+  RegisterOptions o;
+  o.max_outline_score = 0.5 * clear.outline_score;
+  const auto faint = register_antenna(model, scene, o);
+  EXPECT_FALSE(faint.found);
+  EXPECT_NE(faint.why_not.find("tell neither which way it faces nor that the object is this panel"), std::string::npos)
+      << faint.why_not;
+  EXPECT_NE(faint.why_not.find("against a contrasting background"), std::string::npos) << faint.why_not;
+
+  o.max_faint_open_facing_deg = 90.0;  // every facing open allowed: measured, its σ covering the turns
+  const auto allowed = register_antenna(model, scene, o);
+  ASSERT_TRUE(allowed.found) << allowed.why_not;
+  EXPECT_EQ(allowed.verdict, RegistrationVerdict::kAmbiguousShape);
+
+  o.max_faint_open_facing_deg = 0.0;
+  EXPECT_FALSE(o.Check().ok());
 }
 
 // The clear outline limit only warns: a candidate whose outline fits worse than it, but within the

@@ -616,6 +616,32 @@ AntennaRegistration not_seen(const model::AntennaModel& model, double outline_sc
                   model.name, outline_score, o.max_answer_outline_score));
 }
 
+// How far the rivals leave the answer's facing open: the largest angle between a rival's
+// boresight and the answer's, the front/back turn left out (a box turned round has its outline).
+double facing_open(const AntennaRegistration& r) {
+  double open = 0.0;
+  for (const Iso3& T : r.rivals) {
+    const double angle = boresight_angle(T.linear(), r.T_board_antenna.linear());
+    open = std::max(open, std::min(angle, M_PI - angle));
+  }
+  return open;
+}
+
+// The answer meets its outline only faintly and its rivals leave its facing open
+// (RegisterOptions::max_faint_open_facing_deg).
+AntennaRegistration faces_unseen(const model::AntennaModel& model, const AntennaRegistration& r, double open,
+                                 const RegisterOptions& o) {
+  return not_found(
+      r.proposed,
+      fmt::format("the model '{}' meets the photos' edges only faintly (score {:.2f}; a clearly seen antenna scores "
+                  "under {:.2f}) and poses turned {:.0f}° from it about its long axis fit as well (more than {:.0f}°: "
+                  "nearer a side face forward than its front): the photos tell neither which way it faces nor that "
+                  "the object is this panel and not the mast, a mount's pipe or a neighbour (a pipe fits a panel's "
+                  "model at every turn), so its downtilt and roll could be off by degrees; photos from nearer, over "
+                  "a wider arc round it, or with the panel against a contrasting background would help",
+                  model.name, r.outline_score, o.max_outline_score, rad2deg(open), o.max_faint_open_facing_deg));
+}
+
 }  // namespace
 
 std::string to_string(RegistrationVerdict verdict) {
@@ -651,6 +677,8 @@ OptionProblems RegisterOptions::Check() const {
             "max_outline_score, max_faint_outline_score", "0 < max_outline_score ≤ max_faint_outline_score ≤ 1");
   p.require(max_outline_score <= max_answer_outline_score && max_answer_outline_score <= 1, "max_answer_outline_score",
             "in [max_outline_score, 1]");
+  p.require(max_faint_open_facing_deg > 0 && max_faint_open_facing_deg <= 90, "max_faint_open_facing_deg",
+            "in (0, 90]");
   return p;
 }
 
@@ -731,6 +759,9 @@ AntennaRegistration register_antenna(const model::AntennaModel& model, const Ant
   auto out = select(s, std::move(kept), o);
   out.proposed = proposals.size();
   if (out.outline_score > o.max_answer_outline_score) return not_seen(model, out.outline_score, proposals.size(), o);
+  if (const double open = facing_open(out);
+      out.outline_score > o.max_outline_score && open > deg2rad(o.max_faint_open_facing_deg))
+    return faces_unseen(model, out, open, o);
   const auto& answer_model = out.panel_shape ? out.panel_shape->model : model;
   free_the_width(out, answer_model, s, o);
   check_faces(out, answer_model, s, o);

@@ -26,7 +26,8 @@
 // min_outline_views). Among those, only the comparison with the best (pose_selection.hpp) rules a
 // candidate out: a fixed score cut would drop the true pose wherever the edges are faint or
 // cluttered and a wrong pose meets other edges a little better, leaving that wrong pose unique.
-// The answer must meet edges along about a third of its outline (max_answer_outline_score). Its
+// The answer must meet edges along about a third of its outline (max_answer_outline_score), and
+// one met only faintly must show which way it faces (max_faint_open_facing_deg). Its
 // faces are then checked against the region's points (face_plane.hpp), and the pose against each
 // of its long edges left out (long_edge_check.hpp). "Not found"
 // is a value: the result says why and what photo or rectangle would help; a pose that fits clearly
@@ -132,6 +133,13 @@ struct RegisterOptions {
   /// less than they do at its true pose; beyond it the photos do not tell the antenna from what
   /// stands round it, and the answer is none. Fainter candidates still serve as rivals.
   double max_answer_outline_score = 2.0 / 3.0;
+  /// An answer met only faintly (beyond `max_outline_score`) whose rivals turn its boresight by
+  /// more than `max_faint_open_facing_deg` (the front/back turn left out) is none: beyond 45° a
+  /// rival lies nearer the answer turned a side face forward than the answer itself, so the photos
+  /// tell its broad faces from its narrow ones no better than the edges it faintly meets tell a
+  /// panel from a pipe, which fits a panel's model at every turn. The long axis of such an answer
+  /// may be the mast's or a mount's, and its downtilt and roll off by degrees under a small σ.
+  double max_faint_open_facing_deg = 45.0;
   std::size_t min_outline_views = 3;
   OptionProblems Check() const;
 };
