@@ -1,5 +1,6 @@
 #include "antpose/calibration/magnetometer.hpp"
 #include "antpose/calibration/least_squares.hpp"
+#include "antpose/geometry/symmetric3.hpp"
 
 #include <array>
 #include <cmath>
@@ -59,19 +60,19 @@ void refinement_sigmas(MagnetometerCalibration& c, ceres::Problem& problem, cons
   Eigen::Matrix<double, 6, 6, Eigen::RowMajor> cov_s;
   covariance.GetCovarianceBlock(b, b, cov_b.data());
   covariance.GetCovarianceBlock(s, s, cov_s.data());
-  constexpr int kRow[6] = {0, 0, 0, 1, 1, 2}, kCol[6] = {0, 1, 2, 1, 2, 2};
+  const auto& e = kSymmetricEntries;
   const Mat3 S_inv = S_s.inverse();
   const double root = std::cbrt(S_s.determinant());
   Eigen::Matrix<double, 6, 6> J;
   for (int k = 0; k < 6; ++k) {
-    const double trace = (kRow[k] == kCol[k] ? 1.0 : 2.0) * S_inv(kRow[k], kCol[k]);  // tr(S_s⁻¹ ∂S_s/∂s_k)
-    for (int j = 0; j < 6; ++j) J(j, k) = ((j == k ? 1.0 : 0.0) - trace * S_s(kRow[j], kCol[j]) / 3.0) / root;
+    const double trace = (e[k].row == e[k].col ? 1.0 : 2.0) * S_inv(e[k].row, e[k].col);  // tr(S_s⁻¹ ∂S_s/∂s_k)
+    for (int j = 0; j < 6; ++j) J(j, k) = ((j == k ? 1.0 : 0.0) - trace * S_s(e[j].row, e[j].col) / 3.0) / root;
   }
   const Eigen::Matrix<double, 6, 6> cov_n = J * cov_s * J.transpose();
   c.hard_iron_sigma_uT = (variance * cov_b.diagonal()).cwiseMax(0.0).cwiseSqrt();
   Mat3 sigma;
   for (int k = 0; k < 6; ++k)
-    sigma(kRow[k], kCol[k]) = sigma(kCol[k], kRow[k]) = std::sqrt(std::max(0.0, variance * cov_n(k, k)));
+    sigma(e[k].row, e[k].col) = sigma(e[k].col, e[k].row) = std::sqrt(std::max(0.0, variance * cov_n(k, k)));
   c.soft_iron_sigma = sigma;
 }
 

@@ -9,6 +9,7 @@
 
 #include "antpose/camera/board_pose.hpp"
 #include "antpose/core/statistics.hpp"
+#include "antpose/geometry/symmetric3.hpp"
 
 namespace antpose::measure {
 namespace {
@@ -172,7 +173,6 @@ namespace {
 // about 2 %.
 double compass_calibration_sigma(const std::vector<CompassPhoto>& photos, const CompassCalibration& c) {
   using Row = Eigen::Matrix<double, 1, 12>;
-  constexpr int kRow[6] = {0, 0, 0, 1, 1, 2}, kCol[6] = {0, 1, 2, 1, 2, 2};
   const Mat3 unwarp = (c.alignment * c.soft_iron).inverse();
   std::vector<Row> g;
   for (const auto& p : photos) {
@@ -185,7 +185,8 @@ double compass_calibration_sigma(const std::vector<CompassPhoto>& photos, const 
     row.head<3>() = dpsi * (-c.alignment * c.soft_iron);
     for (int k = 0; k < 6; ++k) {
       Mat3 E = Mat3::Zero();
-      E(kRow[k], kCol[k]) = E(kCol[k], kRow[k]) = 1.0;
+      const auto [r, col] = kSymmetricEntries[k];
+      E(r, col) = E(col, r) = 1.0;
       row(3 + k) = dpsi * (c.alignment * E * u);
     }
     row.tail<3>() = dpsi * (-skew(m));
