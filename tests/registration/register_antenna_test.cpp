@@ -350,8 +350,9 @@ TEST(RegisterAntenna, AnAnswerMeetingTooLittleOfItsOutlineIsNone) {
 
 // A pipe where the panel should be: the panel's model fits it about as well at every turn about
 // its long axis. Met clearly, the σ covers the turns; met only faintly, nothing shows that the
-// object is a panel at all (a mast, a mount's pipe), and the answer is none.
-TEST(RegisterAntenna, AFaintAnswerThatShowsNoFacesIsNone) {
+// object is a panel at all (a mast, a mount's pipe), and its downtilt and roll keep only the range
+// panels hang in.
+TEST(RegisterAntenna, AFaintAnswerThatShowsNoFacesKeepsOnlyHowPanelsHang) {
   const model::PanelSpec panel;
   fixture::SceneSpec spec;
   spec.rendered = sim::cylinder_mesh(Vec3(0, 0, -0.5 * panel.height_m), Vec3(0, 0, 0.5 * panel.height_m),
@@ -361,10 +362,15 @@ TEST(RegisterAntenna, AFaintAnswerThatShowsNoFacesIsNone) {
   std::vector<Vec3> viewpoints;
   for (const Vec3& c : scene.viewpoints_board) viewpoints.push_back(s.T_board_antenna.inverse() * c);
   scene.points_board = transformed(model::visible_surface(spec.rendered, viewpoints, 0.02, 5), s.T_board_antenna);
+  const auto axis_source = [](const AntennaRegistration& r) {
+    return std::find_if(r.rotation_covariance_sources.begin(), r.rotation_covariance_sources.end(),
+                        [](const UncertaintySource& u) { return u.source == "long axis not shown to be the panel's"; });
+  };
 
   const auto model = model::parametric_panel(panel);
   const auto clear = register_antenna(model, scene, {});
   ASSERT_TRUE(clear.found) << clear.why_not;
+  EXPECT_EQ(axis_source(clear), clear.rotation_covariance_sources.end());
   double open = 0.0;
   for (const Iso3& T : clear.rivals) {
     const double angle = angle_between(T.linear().col(1), clear.T_board_antenna.linear().col(1));
@@ -375,17 +381,29 @@ TEST(RegisterAntenna, AFaintAnswerThatShowsNoFacesIsNone) {
   RegisterOptions o;
   o.max_outline_score = 0.5 * clear.outline_score;
   const auto faint = register_antenna(model, scene, o);
-  EXPECT_FALSE(faint.found);
-  EXPECT_NE(faint.why_not.find("tell neither which way it faces nor that the object is this panel"), std::string::npos)
-      << faint.why_not;
-  EXPECT_NE(faint.why_not.find("against a contrasting background"), std::string::npos) << faint.why_not;
+  ASSERT_TRUE(faint.found) << faint.why_not;
+  const auto source = axis_source(faint);
+  ASSERT_NE(source, faint.rotation_covariance_sources.end());
+  const Mat3& R = faint.T_board_antenna.linear();
+  const auto sigma_about = [&](const Vec3& axis) { return rad2deg(std::sqrt(axis.dot(source->covariance * axis))); };
+  EXPECT_NEAR(sigma_about(R.col(0)), 30.0 / std::sqrt(12.0), 1e-9);  // downtilt: −12…+18°
+  EXPECT_NEAR(sigma_about(R.col(1)), 10.0 / std::sqrt(12.0), 1e-9);  // roll: ±5°
+  EXPECT_NEAR(sigma_about(R.col(2)), 0.0, 1e-6);
+  const bool warned = std::any_of(faint.warnings.begin(), faint.warnings.end(), [](const std::string& w) {
+    return w.find("nothing shows that the object is this panel") != std::string::npos &&
+           w.find("the range panels hang in (-12…+18° of downtilt") != std::string::npos;
+  });
+  EXPECT_TRUE(warned);
 
-  o.max_faint_open_facing_deg = 90.0;  // every facing open allowed: measured, its σ covering the turns
+  o.max_faint_open_facing_deg = 90.0;  // no facing too open: the σ covers the rivals alone
   const auto allowed = register_antenna(model, scene, o);
   ASSERT_TRUE(allowed.found) << allowed.why_not;
-  EXPECT_EQ(allowed.verdict, RegistrationVerdict::kAmbiguousShape);
+  EXPECT_EQ(axis_source(allowed), allowed.rotation_covariance_sources.end());
 
   o.max_faint_open_facing_deg = 0.0;
+  EXPECT_FALSE(o.Check().ok());
+  o.max_faint_open_facing_deg = 45.0;
+  o.hanging_roll_deg = {5.0, -5.0};
   EXPECT_FALSE(o.Check().ok());
 }
 

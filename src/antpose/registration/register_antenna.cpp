@@ -628,18 +628,22 @@ double facing_open(const AntennaRegistration& r) {
 }
 
 // The answer meets its outline only faintly and its rivals leave its facing open
-// (RegisterOptions::max_faint_open_facing_deg).
-AntennaRegistration faces_unseen(const model::AntennaModel& model, const AntennaRegistration& r, double open,
-                                 const RegisterOptions& o) {
-  return not_found(
-      r.proposed,
-      fmt::format("the model '{}' meets the photos' edges only faintly (score {:.2f}; a clearly seen antenna scores "
-                  "under {:.2f}) and poses turned {:.0f}° from it about its long axis fit as well (more than {:.0f}°: "
-                  "nearer a side face forward than its front): the photos tell neither which way it faces nor that "
-                  "the object is this panel and not the mast, a mount's pipe or a neighbour (a pipe fits a panel's "
-                  "model at every turn), so its downtilt and roll could be off by degrees; photos from nearer, over "
-                  "a wider arc round it, or with the panel against a contrasting background would help",
-                  model.name, r.outline_score, o.max_outline_score, rad2deg(open), o.max_faint_open_facing_deg));
+// (RegisterOptions::max_faint_open_facing_deg): its downtilt and roll as panels hang, a uniform
+// spread's standard deviation (width/√12) about its own x and y axes (left perturbation).
+void keep_only_how_panels_hang(AntennaRegistration& out, double open, const RegisterOptions& o) {
+  const auto spread = [](const std::array<double, 2>& range) { return deg2rad(range[1] - range[0]) / std::sqrt(12.0); };
+  const Mat3& R = out.T_board_antenna.linear();
+  const Vec3 variances(std::pow(spread(o.hanging_downtilt_deg), 2), std::pow(spread(o.hanging_roll_deg), 2), 0.0);
+  out.rotation_covariance_sources.push_back(
+      {"long axis not shown to be the panel's", R * variances.asDiagonal() * R.transpose()});
+  out.warnings.push_back(fmt::format(
+      "the model meets the photos' edges only faintly (score {:.2f}) and poses turned {:.0f}° from it about its long "
+      "axis fit as well: nothing shows that the object is this panel and not a mount's pipe or the mast (a pipe fits "
+      "a panel's model at every turn), whose axis would give its downtilt and roll; their σ covers the range panels "
+      "hang in ({:.0f}…{:+.0f}° of downtilt, {:.0f}…{:+.0f}° of roll); photos from nearer, over a wider arc round it, "
+      "or with the panel against a contrasting background would settle it",
+      out.outline_score, rad2deg(open), o.hanging_downtilt_deg[0], o.hanging_downtilt_deg[1], o.hanging_roll_deg[0],
+      o.hanging_roll_deg[1]));
 }
 
 }  // namespace
@@ -679,6 +683,9 @@ OptionProblems RegisterOptions::Check() const {
             "in [max_outline_score, 1]");
   p.require(max_faint_open_facing_deg > 0 && max_faint_open_facing_deg <= 90, "max_faint_open_facing_deg",
             "in (0, 90]");
+  for (const auto& [range, name] :
+       {std::pair{hanging_downtilt_deg, "hanging_downtilt_deg"}, std::pair{hanging_roll_deg, "hanging_roll_deg"}})
+    p.require(range[0] < range[1] && range[0] >= -90 && range[1] <= 90, name, "an interval within [-90, 90]");
   return p;
 }
 
@@ -759,14 +766,14 @@ AntennaRegistration register_antenna(const model::AntennaModel& model, const Ant
   auto out = select(s, std::move(kept), o);
   out.proposed = proposals.size();
   if (out.outline_score > o.max_answer_outline_score) return not_seen(model, out.outline_score, proposals.size(), o);
-  if (const double open = facing_open(out);
-      out.outline_score > o.max_outline_score && open > deg2rad(o.max_faint_open_facing_deg))
-    return faces_unseen(model, out, open, o);
   const auto& answer_model = out.panel_shape ? out.panel_shape->model : model;
   free_the_width(out, answer_model, s, o);
   check_faces(out, answer_model, s, o);
   judge_long_edges(out, answer_model, s, o);
   warn_of_open_shape(out);
+  if (const double open = facing_open(out);
+      out.outline_score > o.max_outline_score && open > deg2rad(o.max_faint_open_facing_deg))
+    keep_only_how_panels_hang(out, open, o);
   if (out.outline_score > o.max_outline_score)
     out.warnings.push_back(fmt::format(
         "the model's outline meets the photos' edges only faintly (score {:.2f}; a clearly seen antenna scores "

@@ -26,8 +26,9 @@
 // min_outline_views). Among those, only the comparison with the best (pose_selection.hpp) rules a
 // candidate out: a fixed score cut would drop the true pose wherever the edges are faint or
 // cluttered and a wrong pose meets other edges a little better, leaving that wrong pose unique.
-// The answer must meet edges along about a third of its outline (max_answer_outline_score), and
-// one met only faintly must show which way it faces (max_faint_open_facing_deg). Its
+// The answer must meet edges along about a third of its outline (max_answer_outline_score); one
+// met only faintly that does not show which way it faces keeps only the downtilt and roll panels
+// hang in (max_faint_open_facing_deg). Its
 // faces are then checked against the region's points (face_plane.hpp), and the pose against each
 // of its long edges left out (long_edge_check.hpp). "Not found"
 // is a value: the result says why and what photo or rectangle would help; a pose that fits clearly
@@ -35,6 +36,7 @@
 // rectangle is drawn too loosely, and poses that fit only against the mast say the mast was found.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <optional>
 #include <string>
@@ -134,12 +136,17 @@ struct RegisterOptions {
   /// stands round it, and the answer is none. Fainter candidates still serve as rivals.
   double max_answer_outline_score = 2.0 / 3.0;
   /// An answer met only faintly (beyond `max_outline_score`) whose rivals turn its boresight by
-  /// more than `max_faint_open_facing_deg` (the front/back turn left out) is none: beyond 45° a
-  /// rival lies nearer the answer turned a side face forward than the answer itself, so the photos
-  /// tell its broad faces from its narrow ones no better than the edges it faintly meets tell a
-  /// panel from a pipe, which fits a panel's model at every turn. The long axis of such an answer
-  /// may be the mast's or a mount's, and its downtilt and roll off by degrees under a small σ.
+  /// more than `max_faint_open_facing_deg` (the front/back turn left out) shows no faces: beyond
+  /// 45° a rival lies nearer the answer turned a side face forward than the answer itself, and
+  /// the edges it faintly meets tell a panel from a pipe no better (a pipe fits a panel's model at
+  /// every turn about its axis). Its long axis may then be a mount's pipe or the mast's, so its
+  /// downtilt and roll are known only as panels hang: uniform over `hanging_downtilt_deg` and
+  /// `hanging_roll_deg` (mechanical downtilt brackets, the outline search's range), whose standard
+  /// deviations join its covariance about its own x and y axes ("long axis not shown to be the
+  /// panel's"), with a warning.
   double max_faint_open_facing_deg = 45.0;
+  std::array<double, 2> hanging_downtilt_deg{-12.0, 18.0};
+  std::array<double, 2> hanging_roll_deg{-5.0, 5.0};
   std::size_t min_outline_views = 3;
   OptionProblems Check() const;
 };
