@@ -28,12 +28,12 @@
 // cluttered and a wrong pose meets other edges a little better, leaving that wrong pose unique.
 // The answer must meet edges along about a third of its outline (max_answer_outline_score); one
 // met only faintly that does not show which way it faces keeps only the downtilt and roll panels
-// hang in (max_faint_open_facing_deg). Its
-// faces are then checked against the region's points (face_plane.hpp), and the pose against each
-// of its long edges left out (long_edge_check.hpp). "Not found"
-// is a value: the result says why and what photo or rectangle would help; a pose that fits clearly
-// but spans too little of a rectangle in which nothing else fits more than faintly says the
-// rectangle is drawn too loosely, and poses that fit only against the mast say the mast was found.
+// hang in (max_faint_open_facing_deg). Its faces are then checked against the region's points
+// (face_plane.hpp), and the pose against each of its long edges left out (long_edge_check.hpp).
+// "Not found" is a value: the result says why and what photo or rectangle would help; a pose that
+// fits clearly but spans too little of a rectangle in which nothing else fits more than faintly
+// says the rectangle is drawn too loosely, and poses that fit only against the mast say the mast
+// was found.
 #pragma once
 
 #include <array>
