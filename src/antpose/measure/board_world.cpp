@@ -194,8 +194,9 @@ double compass_calibration_sigma(const std::vector<CompassPhoto>& photos, const 
   }
   if (g.empty()) return 0.0;
   Eigen::Matrix<double, 12, 1> sigma;
-  sigma << c.hard_iron_sigma_uT, c.soft_iron_sigma(0, 0), c.soft_iron_sigma(0, 1), c.soft_iron_sigma(0, 2),
-      c.soft_iron_sigma(1, 1), c.soft_iron_sigma(1, 2), c.soft_iron_sigma(2, 2), c.alignment_sigma_rad;
+  sigma.head<3>() = c.hard_iron_sigma_uT;
+  for (int k = 0; k < 6; ++k) sigma(3 + k) = c.soft_iron_sigma(kSymmetricEntries[k].row, kSymmetricEntries[k].col);
+  sigma.tail<3>() = c.alignment_sigma_rad;
   std::mt19937_64 rng(1);
   std::normal_distribution<double> unit(0.0, 1.0);
   constexpr int kDraws = 1000;

@@ -30,15 +30,15 @@ void use_compass(WorldAlignment& out, const Capture& capture, const CameraPoses&
                              camera_imu.R_device_camera.transpose());
   }
   const auto fields = field_at_photos(data, track, shot_t, R_world_device, options.field.half_window_s);
-  std::vector<Vec3> field_world_uT, p_world_m;
   std::vector<CompassPhoto> compass;
   for (std::size_t i = 0; i < fields.size(); ++i)
-    if (fields[i]) field_world_uT.push_back(*fields[i]), compass.push_back({*fields[i], R_world_device[i]});
-  if (options.heading_from_compass) {
+    if (fields[i]) compass.push_back({*fields[i], R_world_device[i]});
+  if (options.heading_from_compass)
     out.board = heading_from_field(std::move(out.board), compass, camera_imu.compass, options.compass);
-    const Mat3 R_turn = exp_so3(Vec3(0.0, 0.0, out.board.compass_turn_rad.value_or(0.0)));
-    for (Vec3& b : field_world_uT) b = R_turn * b;
-  }
+  // The fields through the board's heading as now decided.
+  const Mat3 R_turn = exp_so3(Vec3(0.0, 0.0, out.board.compass_turn_rad.value_or(0.0)));
+  std::vector<Vec3> field_world_uT, p_world_m;
+  for (const auto& p : compass) field_world_uT.push_back(R_turn * p.field_world_uT);
   // Where each photo was taken: the camera centre in the board frame, turned to world axes.
   for (std::size_t i = 0; i < fields.size(); ++i)
     if (fields[i])
