@@ -258,6 +258,20 @@ TEST(BoardWorld, TheCompasssCalibrationSigmaIsTheSpreadOfItsTurnOverTheCalibrati
 // The same σ against what a calibration leaves: phones drawn within a typical phone's tolerances,
 // each calibrated as `calibrate imu` does (18 held poses, then a tumble), photographed upright
 // round a board. The heading the compass gives the board, against the truth, over the σ it states.
+TEST(BoardWorld, ACompassCalibrationNeedsTheSigmaOfEachOfItsParameters) {
+  imu::ImuCalibration imu;
+  imu.mag_soft_iron = Mat3::Identity() * 1.01;
+  imu.mag_hard_iron_sigma_uT = Vec3(0.1, 0.2, 0.3);
+  imu.mag_soft_iron_sigma = Mat3::Constant(0.002);
+  EXPECT_FALSE(compass_calibration(imu)) << "no σ of the alignment: the profile's compass σ is unknown";
+  imu.mag_alignment_sigma_rad = Vec3::Constant(0.001);
+  const auto c = compass_calibration(imu);
+  ASSERT_TRUE(c);
+  EXPECT_TRUE(c->soft_iron.isApprox(imu.mag_soft_iron));
+  EXPECT_EQ(c->hard_iron_sigma_uT, *imu.mag_hard_iron_sigma_uT);
+  EXPECT_EQ(c->alignment_sigma_rad, *imu.mag_alignment_sigma_rad);
+}
+
 TEST(BoardWorld, TheCompasssCalibrationSigmaCoversWhatCalibratedPhonesLeave) {
   const Vec3 B_world(0.0, 24.0, -41.569219381653056);  // the simulator's field: magnetic north, dip 60°
   std::mt19937_64 rng(5);
@@ -276,9 +290,8 @@ TEST(BoardWorld, TheCompasssCalibrationSigmaCoversWhatCalibratedPhonesLeave) {
     calibration::CalibrateImuOptions turned;
     turned.accelerometer = turned.gyroscope = false;
     const auto cal = calibration::calibrate_imu(sim::simulate_imu(sim), turned, d, "tumble", base).calibration;
-    ASSERT_TRUE(cal.mag_hard_iron_sigma_uT && cal.mag_soft_iron_sigma && cal.mag_alignment_sigma_rad);
-    const CompassCalibration compass{cal.mag_soft_iron, cal.mag_alignment, *cal.mag_hard_iron_sigma_uT,
-                                     *cal.mag_soft_iron_sigma, *cal.mag_alignment_sigma_rad};
+    const auto compass = compass_calibration(cal);
+    ASSERT_TRUE(compass);
     // The calibrated frame: the accelerometer's corrected axes (their rotation part), which the
     // camera's calibration refers to.
     const Mat3 C =
@@ -294,7 +307,7 @@ TEST(BoardWorld, TheCompasssCalibrationSigmaCoversWhatCalibratedPhonesLeave) {
         const Mat3 R_world_calibrated = R_world_device * R_calibrated_device.transpose();
         photos.push_back({R_world_calibrated * cal.correct_mag(raw), R_world_calibrated});
       }
-      const auto board = heading_from_field({}, photos, compass, {});
+      const auto board = heading_from_field({}, photos, *compass, {});
       ASSERT_TRUE(board.compass_turn_rad);
       z.push_back(*board.compass_turn_rad / std::sqrt(board.covariance(2, 2)));
     }

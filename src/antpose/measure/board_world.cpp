@@ -164,13 +164,19 @@ BoardWorldAttitude board_world_attitude(const std::vector<BoardPhoto>& photos,
   return out;
 }
 
+std::optional<CompassCalibration> compass_calibration(const imu::ImuCalibration& imu) {
+  if (!imu.mag_hard_iron_sigma_uT || !imu.mag_soft_iron_sigma || !imu.mag_alignment_sigma_rad) return std::nullopt;
+  return CompassCalibration{imu.mag_soft_iron, imu.mag_alignment, *imu.mag_hard_iron_sigma_uT, *imu.mag_soft_iron_sigma,
+                            *imu.mag_alignment_sigma_rad};
+}
+
 namespace {
 
 // σ_cal (heading_from_field). Each photo's heading change is linear in the calibration's errors
 // e = (δb, the 6 entries of δS, δ), row g_i; the compass takes their median, which is not linear
 // in e (the photo in the middle changes with e's direction), so its spread is sampled over draws
 // of e: a fixed generator, so that a capture's σ is reproducible; 1000 draws leave it within
-// about 2 %.
+// about 2 %. `photos`: at least one, each field with a horizontal part (heading_from_field's).
 double compass_calibration_sigma(const std::vector<CompassPhoto>& photos, const CompassCalibration& c) {
   using Row = Eigen::Matrix<double, 1, 12>;
   const Mat3 unwarp = (c.alignment * c.soft_iron).inverse();
@@ -178,7 +184,6 @@ double compass_calibration_sigma(const std::vector<CompassPhoto>& photos, const 
   for (const auto& p : photos) {
     const Vec3& b = p.field_world_uT;
     const double h2 = b.head<2>().squaredNorm();
-    if (!(h2 > 0.0)) continue;
     const Eigen::RowVector3d dpsi = Eigen::RowVector3d(b.y() / h2, -b.x() / h2, 0.0) * p.R_world_device;
     const Vec3 m = p.R_world_device.transpose() * b, u = unwarp * m;
     Row row;
@@ -192,7 +197,6 @@ double compass_calibration_sigma(const std::vector<CompassPhoto>& photos, const 
     row.tail<3>() = dpsi * (-skew(m));
     g.push_back(row);
   }
-  if (g.empty()) return 0.0;
   Eigen::Matrix<double, 12, 1> sigma;
   sigma.head<3>() = c.hard_iron_sigma_uT;
   for (int k = 0; k < 6; ++k) sigma(3 + k) = c.soft_iron_sigma(kSymmetricEntries[k].row, kSymmetricEntries[k].col);

@@ -23,6 +23,7 @@
 
 #include "antpose/core/error.hpp"
 #include "antpose/geometry/rotation.hpp"
+#include "antpose/imu/imu_calibration.hpp"
 #include "antpose/orientation/estimator.hpp"
 
 namespace antpose::measure {
@@ -44,6 +45,10 @@ struct CompassCalibration {
   Mat3 soft_iron_sigma = Mat3::Zero();      // per entry of S (symmetric)
   Vec3 alignment_sigma_rad = Vec3::Zero();  // per axis of A's rotation vector
 };
+
+/// The magnetometer part of an IMU calibration with its σ; nullopt where the calibration gives no
+/// σ for one of its parameters (a magnetometer calibrated before they were recorded, or none).
+std::optional<CompassCalibration> compass_calibration(const imu::ImuCalibration& imu);
 
 struct CameraImu {
   Mat3 R_device_camera = Mat3::Identity();

@@ -17,10 +17,7 @@ NonContactSetup device_setup(const store::DeviceProfile& device, const std::file
   s.camera_imu.time_offset_s = device.camera_imu->time_offset_s;
   if (device.camera_imu->rotation_sigma_rad)
     s.camera_imu.covariance = device.camera_imu->rotation_sigma_rad->cwiseAbs2().asDiagonal();
-  const auto& imu = device.imu;
-  if (imu.mag_hard_iron_sigma_uT && imu.mag_soft_iron_sigma && imu.mag_alignment_sigma_rad)
-    s.camera_imu.compass = CompassCalibration{imu.mag_soft_iron, imu.mag_alignment, *imu.mag_hard_iron_sigma_uT,
-                                              *imu.mag_soft_iron_sigma, *imu.mag_alignment_sigma_rad};
+  s.camera_imu.compass = compass_calibration(device.imu);
   return s;
 }
 

@@ -637,12 +637,12 @@ void keep_only_how_panels_hang(AntennaRegistration& out, double open, const Regi
   out.rotation_covariance_sources.push_back(
       {"long axis not shown to be the panel's", R * variances.asDiagonal() * R.transpose()});
   out.warnings.push_back(fmt::format(
-      "the model meets the photos' edges only faintly (score {:.2f}) and poses turned {:.0f}° from it about its long "
+      "the model meets the photos' edges only faintly and poses turned {:.0f}° from it about its long "
       "axis fit as well: nothing shows that the object is this panel and not a mount's pipe or the mast (a pipe fits "
       "a panel's model at every turn), whose axis would give its downtilt and roll; their σ covers the range panels "
       "hang in ({:.0f}…{:+.0f}° of downtilt, {:.0f}…{:+.0f}° of roll); photos from nearer, over a wider arc round it, "
       "or with the panel against a contrasting background would settle it",
-      out.outline_score, rad2deg(open), o.hanging_downtilt_deg[0], o.hanging_downtilt_deg[1], o.hanging_roll_deg[0],
+      rad2deg(open), o.hanging_downtilt_deg[0], o.hanging_downtilt_deg[1], o.hanging_roll_deg[0],
       o.hanging_roll_deg[1]));
 }
 
