@@ -656,6 +656,30 @@ TEST(Silhouette, TheModelsShapeErrorIsMeasuredByItsOffsetsFromTheOutline) {
   EXPECT_GT(shape_sigma_m(too_large, options), departing);
 }
 
+TEST(Silhouette, TheWhiteNoiseIsTheScatterAboutEachEdgesOffset) {
+  // A model larger than the panel leaves each mesh edge offset from its outline: the shape term
+  // carries those offsets, and the white noise, the samples' scatter about them, stays that of a
+  // matching model instead of taking the offsets in a second time.
+  const auto& s = scene();
+  SilhouetteOptions options;
+  options.rival_yaw_offsets_rad.clear();
+  model::PanelSpec larger;
+  larger.width_m += 0.012, larger.depth_m += 0.008;
+  const auto matching = refine_by_silhouette(s.mesh_antenna, s.T_board_antenna, s.views, s.intrinsics, options);
+  const auto departing = refine_by_silhouette(model::parametric_panel(larger).mesh_antenna, s.T_board_antenna, s.views,
+                                              s.intrinsics, options);
+  const auto rotation = [](const OutlineCovarianceParts::Mat6& c) { return c.topLeftCorner<3, 3>().trace(); };
+  const auto& m = matching.covariance_parts;
+  const auto& d = departing.covariance_parts;
+  std::printf("outline RMS %.2f / %.2f px; noise %.3g / %.3g rad², shape %.3g / %.3g rad²\n", matching.rms_px,
+              departing.rms_px, rotation(m.noise), rotation(d.noise), rotation(m.shape), rotation(d.shape));
+  ASSERT_GT(departing.rms_px, 1.5 * matching.rms_px) << "the larger model must leave offsets";
+  // The offsets differ a little from photo to photo (the depth shows at some angles only), and
+  // that stays noise; the residuals' whole variance would be (RMS ratio)² ≈ 36 times larger.
+  EXPECT_LT(rotation(d.noise), 3.0 * rotation(m.noise));
+  EXPECT_GT(rotation(d.shape), 2.0 * rotation(m.shape));
+}
+
 // Development check on a simulated capture (`antpose simulate capture --scenario antenna`), with
 // the TRUE camera poses and a start perturbed both ways (5° yaw, 2°, 2°, 4.8 cm):
 //   SIL_CAPTURE=/tmp/cap build/tests/antpose_tests --gtest_also_run_disabled_tests

@@ -262,21 +262,24 @@ class Descender {
   bool reached_middle_ = false;  // by any search line of any evaluation
 };
 
-// σ_shape (file comment): each mesh edge's offset from the outline in metres and its noise
-// variance, the offsets' excess over their noise over G − 6 degrees of freedom, pooled with the
-// prior. The noise is the samples' scatter about their edge's offset, inflated for their overlap
-// as far as the edge has samples to overlap.
+// σ_shape (file comment): each mesh edge's offset from the outline in metres and its variance
+// from what the covariance already holds, the offsets' excess over it over G − 6 degrees of
+// freedom, pooled with the prior. That variance is the samples' noise (their scatter about their
+// edge's offset, inflated for their overlap as far as the edge has samples to overlap) and the
+// edge bias: an offset of edge_bias_px at every sample of the edge moves its offset by
+// edge_bias_px Σ w p / Σ w p², and the bias term carries it already.
 struct EdgeOffset {  // weighted sums over one mesh edge's samples (w weight, p px per m, r residual)
-  double wpr = 0, wpp = 0, w2pp = 0, w = 0, wrr = 0;
+  double wpr = 0, wp = 0, wpp = 0, w2pp = 0, w = 0, wrr = 0;
   std::size_t count = 0;
   void add(double wi, double p, double r) {
-    wpr += wi * p * r, wpp += wi * p * p, w2pp += wi * wi * p * p, w += wi, wrr += wi * r * r, ++count;
+    wpr += wi * p * r, wp += wi * p, wpp += wi * p * p, w2pp += wi * wi * p * p, w += wi, wrr += wi * r * r, ++count;
   }
 };
 
 struct ShapeSigma {
   double sigma_m = 0;
   std::size_t edges = 0;
+  std::optional<double> scatter_px2;  // the samples' variance about their edge's offset; none: no edge has two
 };
 
 ShapeSigma shape_sigma(const std::vector<EdgeOffset>& edge, const SilhouetteOptions& o) {
@@ -284,38 +287,33 @@ ShapeSigma shape_sigma(const std::vector<EdgeOffset>& edge, const SilhouetteOpti
   double scatter = 0, dof = 0;  // the samples' weighted scatter about their edge's offset
   for (const auto& e : edge)
     if (e.count > 1) scatter += e.wrr - e.wpr * e.wpr / e.wpp, dof += e.w - 1;
-  const double sigma2_px = dof > 0 ? std::max(0.0, scatter) / dof : 0.0;
+  const std::optional<double> sigma2_px = dof > 0 ? std::optional<double>(std::max(0.0, scatter) / dof) : std::nullopt;
   double excess = 0;
   std::size_t edges = 0;
   for (const auto& e : edge) {
     if (e.count < 2) continue;
-    const double offset = e.wpr / e.wpp;
-    const double noise = sigma2_px * std::min(kappa, double(e.count)) * e.w2pp / (e.wpp * e.wpp);
-    excess += offset * offset - noise, ++edges;
+    const double offset = e.wpr / e.wpp, bias = o.edge_bias_px * e.wp / e.wpp;
+    const double noise = sigma2_px.value_or(0.0) * std::min(kappa, double(e.count)) * e.w2pp / (e.wpp * e.wpp);
+    excess += offset * offset - noise - bias * bias, ++edges;
   }
   const double nu0 = o.shape_prior_edges, prior2 = o.shape_tolerance_m * o.shape_tolerance_m;
   const double nu = edges > 6 ? double(edges - 6) : 0.0;
   const double measured2 = nu > 0 ? std::max(0.0, excess) / nu : 0.0;
-  if (nu0 + nu <= 0) return {o.shape_tolerance_m, edges};
-  return {std::sqrt((nu0 * prior2 + nu * measured2) / (nu0 + nu)), edges};
+  if (nu0 + nu <= 0) return {o.shape_tolerance_m, edges, sigma2_px};
+  return {std::sqrt((nu0 * prior2 + nu * measured2) / (nu0 + nu)), edges, sigma2_px};
 }
 
 // The covariance at the solution (file comment): the sandwich H⁻¹ (Σ_white + Σ_bias) H⁻¹ of white
 // edge noise (inflated for the samples' overlap), errors shared by all samples of a mesh edge (the
-// model's shape error σ_shape, the same in every view; an edge-localisation bias per view and edge:
-// background, blur, shading) and that bias common to the whole outline (a dilation). The prior
-// counts once as information (in H) and once as its own noise (in M).
+// model's shape error σ_shape and an edge-localisation bias: background, blur, shading, alike in
+// every view) and that bias common to the whole outline (a dilation). The white noise is the
+// samples' scatter about their own edge's offset: the offsets are what the shared terms carry, and
+// the residuals' whole variance would count them twice. The prior counts once as information (in
+// H) and once as its own noise (in M).
 void covariance_at(SilhouetteResult& result, const Gathered& g, const Normal& n, const Mat6& Hinv, double prior_weight,
                    const std::optional<RotationPrior>& prior, const EdgeMesh& m, const Pose& pose,
                    const SilhouetteOptions& o) {
   result.rms_px = std::sqrt(n.sum_wr2 / n.sum_w);
-  const double parameters = o.free_outline_width ? 7.0 : 6.0;
-  const double sigma2 = n.sum_wr2 / std::max(1.0, n.sum_w - parameters);
-  const double inflation = std::max(1.0, o.correlation_length_px / o.sample_spacing_px);
-  Mat6 noise = sigma2 * inflation * n.H;
-  if (prior)
-    noise.topLeftCorner<3, 3>() +=
-        (prior_weight * prior_weight - sigma2 * inflation * prior_weight) * prior->information;
   // Per mesh edge: b_g for a shape error of 1 m (scaled by σ_shape once it is measured from the
   // same samples' offsets) and for the edge bias.
   std::vector<Vec6> shape(m.edges.size(), Vec6::Zero()), bias(m.edges.size(), Vec6::Zero());
@@ -336,6 +334,13 @@ void covariance_at(SilhouetteResult& result, const Gathered& g, const Normal& n,
   const ShapeSigma shape_error = shape_sigma(offsets, o);
   result.shape_sigma_m = shape_error.sigma_m;
   result.shape_edges = shape_error.edges;
+  const double parameters = o.free_outline_width ? 7.0 : 6.0;
+  const double sigma2 = shape_error.scatter_px2.value_or(n.sum_wr2 / std::max(1.0, n.sum_w - parameters));
+  const double inflation = std::max(1.0, o.correlation_length_px / o.sample_spacing_px);
+  Mat6 noise = sigma2 * inflation * n.H;
+  if (prior)
+    noise.topLeftCorner<3, 3>() +=
+        (prior_weight * prior_weight - sigma2 * inflation * prior_weight) * prior->information;
   Mat6 shape_M = Mat6::Zero(), bias_M = Mat6::Zero();
   for (std::size_t e = 0; e < m.edges.size(); ++e)
     shape_M += shape[e] * shape[e].transpose(), bias_M += bias[e] * bias[e].transpose();

@@ -35,8 +35,9 @@
 // find it; the best score within max_rotation_change_rad of the start wins and a rival scoring
 // nearly as well (rival_margin) or better is reported (converged = false, a warning).
 //
-// Covariance (at the solution, H = Jᵀ W J): H⁻¹ (κ σ² H + Σ_g b_g b_gᵀ) H⁻¹. σ² is the weighted
-// residual variance, κ = correlation_length_px / sample_spacing_px because neighbouring samples
+// Covariance (at the solution, H = Jᵀ W J): H⁻¹ (κ σ² H + Σ_g b_g b_gᵀ) H⁻¹. σ² is the samples'
+// weighted variance about their mesh edge's offset (the offsets are the b_g's, below, and are not
+// counted twice), κ = correlation_length_px / sample_spacing_px because neighbouring samples
 // share the blur and JPEG blocks. The sum models errors common to all samples of a mesh edge,
 // which do not average out along it nor over the views: b_g = Σ_{i∈g} w_i J_iᵀ s_i over all views,
 // once with s_i = f · σ_shape / depth (the model's shape error: a real radome's extrusion,
@@ -52,7 +53,8 @@
 // σ_shape is measured where the photos show it: each mesh edge's offset from its outline,
 // d_g = Σ w p r / Σ w p² (m; p = f / depth), has the noise variance v_g of its samples' scatter
 // about it, so over the G edges that show one the shape error's variance is estimated as
-// σ̂² = Σ (d_g² − v_g) / (G − 6), six of the offsets being taken up by the pose. It is pooled with
+// σ̂² = Σ (d_g² − v_g) / (G − 6), six of the offsets being taken up by the pose; v_g also holds
+// the edge bias's share (edge_bias_px Σ w p / Σ w p²)², which its own b_g carries. It is pooled with
 // the prior shape_tolerance_m, which counts as shape_prior_edges edges (a scaled inverse-χ²
 // prior; Gelman et al., Bayesian Data Analysis, 3rd ed., §2.6):
 //   σ_shape² = (ν₀ σ₀² + (G − 6) σ̂²) / (ν₀ + G − 6),
