@@ -164,10 +164,11 @@ BoardWorldAttitude board_world_attitude(const std::vector<BoardPhoto>& photos,
   return out;
 }
 
-std::optional<CompassCalibration> compass_calibration(const imu::ImuCalibration& imu) {
-  if (!imu.mag_hard_iron_sigma_uT || !imu.mag_soft_iron_sigma || !imu.mag_alignment_sigma_rad) return std::nullopt;
-  return CompassCalibration{imu.mag_soft_iron, imu.mag_alignment, *imu.mag_hard_iron_sigma_uT, *imu.mag_soft_iron_sigma,
-                            *imu.mag_alignment_sigma_rad};
+std::optional<CompassCalibration> compass_calibration(const imu::ImuCalibration& calibration) {
+  if (!calibration.mag_hard_iron_sigma_uT || !calibration.mag_soft_iron_sigma || !calibration.mag_alignment_sigma_rad)
+    return std::nullopt;
+  return CompassCalibration{calibration.mag_soft_iron, calibration.mag_alignment, *calibration.mag_hard_iron_sigma_uT,
+                            *calibration.mag_soft_iron_sigma, *calibration.mag_alignment_sigma_rad};
 }
 
 namespace {

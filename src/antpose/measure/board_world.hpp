@@ -48,7 +48,7 @@ struct CompassCalibration {
 
 /// The magnetometer part of an IMU calibration with its σ; nullopt where the calibration gives no
 /// σ for one of its parameters (a magnetometer calibrated before they were recorded, or none).
-std::optional<CompassCalibration> compass_calibration(const imu::ImuCalibration& imu);
+std::optional<CompassCalibration> compass_calibration(const imu::ImuCalibration& calibration);
 
 struct CameraImu {
   Mat3 R_device_camera = Mat3::Identity();
