@@ -135,6 +135,12 @@ double score(const Gathered& g, const SilhouetteOptions& o, bool with_attachment
   return (sum + double(c.candidates - found)) / double(candidates);
 }
 
+// κ of the file comment: how many samples along the contour share one edge error (blur, JPEG
+// blocks), the factor by which their white noise is inflated.
+double overlap_inflation(const SilhouetteOptions& o) {
+  return std::max(1.0, o.correlation_length_px / o.sample_spacing_px);
+}
+
 // Adds the rotation prior to the normal equations as a measurement of the edges' units: its
 // information × the edges' residual variance × the correlation inflation (so that it weighs as a
 // Gaussian of its own covariance would against theirs). Returns that factor (0 without a prior).
@@ -142,7 +148,7 @@ double add_prior(Normal& n, const Mat3& R_board_antenna, const std::optional<Rot
                  const SilhouetteOptions& o) {
   if (!prior || n.sum_w <= 0) return 0.0;
   const double sigma2 = std::max(n.sum_wr2 / n.sum_w, 0.25 * 0.25);
-  const double weight = sigma2 * std::max(1.0, o.correlation_length_px / o.sample_spacing_px);
+  const double weight = sigma2 * overlap_inflation(o);
   const Vec3 r = log_so3(prior->R_board_antenna * R_board_antenna.transpose());
   n.H.topLeftCorner<3, 3>() += weight * prior->information;
   n.b.head<3>() += weight * prior->information * r;
@@ -283,7 +289,7 @@ struct ShapeSigma {
 };
 
 ShapeSigma shape_sigma(const std::vector<EdgeOffset>& edge, const SilhouetteOptions& o) {
-  const double kappa = std::max(1.0, o.correlation_length_px / o.sample_spacing_px);
+  const double kappa = overlap_inflation(o);
   double scatter = 0, dof = 0;  // the samples' weighted scatter about their edge's offset
   for (const auto& e : edge)
     if (e.count > 1) scatter += e.wrr - e.wpr * e.wpr / e.wpp, dof += e.w - 1;
@@ -336,7 +342,7 @@ void covariance_at(SilhouetteResult& result, const Gathered& g, const Normal& n,
   result.shape_edges = shape_error.edges;
   const double parameters = o.free_outline_width ? 7.0 : 6.0;
   const double sigma2 = shape_error.scatter_px2.value_or(n.sum_wr2 / std::max(1.0, n.sum_w - parameters));
-  const double inflation = std::max(1.0, o.correlation_length_px / o.sample_spacing_px);
+  const double inflation = overlap_inflation(o);
   Mat6 noise = sigma2 * inflation * n.H;
   if (prior)
     noise.topLeftCorner<3, 3>() +=
