@@ -345,7 +345,7 @@ TEST(CalibrateCamera, BadPhotosAreReportedAndTheCalibrationContinues) {
   EXPECT_EQ(rejected[2].first, "images/partial.png");
   EXPECT_THAT(rejected[2].second, HasSubstr("board partly out of view"));
   EXPECT_EQ(rejected[3].first, "images/broken.jpg");
-  EXPECT_THAT(rejected[3].second, HasSubstr("unreadable image"));
+  EXPECT_THAT(rejected[3].second, HasSubstr("cannot be decoded: not a JPEG, PNG or TIFF photo"));
   for (const char* name : {"page.png", "blurred.png", "partial.png", "broken.jpg"}) {
     const bool named = std::any_of(diagnostics.warnings().begin(), diagnostics.warnings().end(),
                                    [&](const Warning& w) { return w.file.filename() == name; });
@@ -357,7 +357,7 @@ TEST(CalibrateCamera, BadPhotosAreReportedAndTheCalibrationContinues) {
   EXPECT_NEAR(r.rms_px, ref.rms, 1e-6);
   const std::string table = describe(r);
   EXPECT_THAT(table, HasSubstr("images/broken.jpg"));
-  EXPECT_THAT(table, HasSubstr("refused: unreadable image"));
+  EXPECT_THAT(table, HasSubstr("refused: cannot be decoded"));
   EXPECT_THAT(table, HasSubstr("13 of 17 photos used"));
   fmt::print("{}", table);
   // The camera file lists the refused photos with their reasons and stays readable.
@@ -380,7 +380,7 @@ TEST(CalibrateCamera, TooFewGoodPhotosIsAMeasurementError) {
     FAIL();
   } catch (const MeasurementError& e) {
     EXPECT_THAT(e.what(), HasSubstr("camera calibration: 2 usable photos (need at least 3); refused:"));
-    EXPECT_THAT(e.what(), HasSubstr("images/broken.jpg: unreadable image"));
+    EXPECT_THAT(e.what(), HasSubstr("images/broken.jpg: cannot be decoded"));
     EXPECT_THAT(e.what(), HasSubstr("images/blurred.png: blurred"));
   }
 }

@@ -254,6 +254,8 @@ TEST(WmmElements, RejectsPositionsOutsideTheModel) {
               HasSubstr("height 851 km is outside the model's range [-1, 850] km"));
   EXPECT_THAT(invalid_argument_message([&] { m.evaluate(10, 0, -1.5, 2025.5); }), HasSubstr("height -1.5 km"));
   EXPECT_THAT(invalid_argument_message([&] { m.evaluate(10, NAN, 0, 2025.5); }), HasSubstr("longitude nan"));
+  EXPECT_THAT(invalid_argument_message([&] { m.evaluate(10, 1e16, 0, 2025.5); }),
+              HasSubstr("longitude 1e+16 deg is outside [-360, 360]"));
   EXPECT_THAT(invalid_argument_message([&] { m.evaluate(10, 0, 0, INFINITY); }), HasSubstr("decimal year inf"));
   EXPECT_NO_THROW(m.evaluate(10, 0, -1.0, 2025.5));
   EXPECT_NO_THROW(m.evaluate(10, 0, 850.0, 2025.5));

@@ -247,13 +247,45 @@ TEST(CaptureWarnings, ShotOutsideSensorSpanAndMissingImage) {
   TempDir dir;
   write_minimal(dir.path());
   write_file(dir / "images" / "a.jpg", "x");
-  write_file(dir / "shots.csv", "index,t,image\n0,0.5,images/a.jpg\n\n1,7.5,images/a.jpg\n");
+  write_file(dir / "images" / "b.jpg", "x");
+  write_file(dir / "shots.csv", "index,t,image\n0,0.5,images/a.jpg\n\n1,7.5,images/b.jpg\n");
   Diagnostics d;
   read_capture(dir.path(), d);
   ASSERT_EQ(d.warnings().size(), 1u);
   EXPECT_THAT(d.warnings()[0].to_string(), HasSubstr("shots.csv:4: shot 1 at t = 7.5 s lies outside the sensor data"));
   write_file(dir / "shots.csv", "index,t,image\n0,0.5,images/a.jpg\n1,0.7,images/missing.jpg\n");
   EXPECT_THAT(error_of(dir.path()), HasSubstr("shots.csv:3: image 'images/missing.jpg' not found"));
+}
+
+TEST(CaptureStreams, VectorColumnsAreTakenByNameInAnyOrder) {
+  TempDir dir;
+  write_minimal(dir.path());
+  write_file(dir / "sensors" / "magnetometer.csv",
+             "t,z,temp,y,x\n0,25,31.5,-30,20\n0.5,26,31.5,-31,21\n1,25,31.6,-30,20\n");
+  Diagnostics d;
+  const Capture c = read_capture(dir.path(), d);
+  const Stream& mag = c.require("magnetometer");
+  ASSERT_TRUE(mag.has_xyz());
+  EXPECT_EQ(mag.columns, (std::vector<std::string>{"x", "y", "z", "temp"}));
+  EXPECT_EQ(mag.xyz(1), Vec3(21, -31, 26));
+  write_file(dir / "sensors" / "magnetometer.csv", "t,x,z\n0,20,25\n1,20,25\n");
+  EXPECT_THAT(error_of(dir.path()), HasSubstr("magnetometer.csv:1: no column 'y': the magnetometer stream has the "
+                                              "columns t,x,z (expected t,x,y,z; extra columns are allowed)"));
+}
+
+TEST(CaptureErrors, AnImagePathThatIsAFolderOrLeadsOutIsSaidSo) {
+  TempDir dir;
+  write_minimal(dir.path());
+  std::filesystem::create_directories(dir / "images" / "b.jpg");
+  write_file(dir / "shots.csv", "index,t,image\n0,0.5,images/b.jpg\n");
+  EXPECT_THAT(error_of(dir.path()), HasSubstr("shots.csv:2: image 'images/b.jpg' is a folder, expected a photo file"));
+  write_file(dir / "shots.csv", "index,t,image\n0,0.5,/etc/hostname\n");
+  EXPECT_THAT(error_of(dir.path()), HasSubstr("shots.csv:2: image '/etc/hostname' is an absolute path"));
+  write_file(dir / "shots.csv", "index,t,image\n0,0.5,images/a.jpg\n1,0.6,images/./a.jpg\n");
+  write_file(dir / "images" / "a.jpg", "x");
+  EXPECT_THAT(error_of(dir.path()), HasSubstr("shots.csv:3: image 'images/./a.jpg' is listed again (first on line 2)"));
+  write_file(dir / "shots.csv", "index,t,image\n0,0.5,images/../../x.jpg\n");
+  EXPECT_THAT(error_of(dir.path()), HasSubstr("image 'images/../../x.jpg' leads out of the capture folder"));
 }
 
 TEST(CaptureUnits, AccelerometerInGIsConvertedOrRefused) {

@@ -1,5 +1,7 @@
 #include "support/test_support.hpp"
 
+#include <unistd.h>
+
 #include <sys/wait.h>
 
 #include <cstdio>
@@ -48,10 +50,12 @@ void write_file(const fs::path& file, std::string_view content) {
 
 std::filesystem::path cli_path() { return ANTPOSE_CLI_PATH; }
 
-CliResult run_cli(const std::string& args) {
+namespace {
+
+CliResult run_command(const std::string& prefix, const std::string& args) {
   TempDir dir;
-  const std::string cmd =
-      fmt::format("'{}' {} >'{}' 2>'{}'", cli_path().string(), args, (dir / "out").string(), (dir / "err").string());
+  const std::string cmd = fmt::format("{}'{}' {} >'{}' 2>'{}'", prefix, cli_path().string(), args,
+                                      (dir / "out").string(), (dir / "err").string());
   const int raw = std::system(cmd.c_str());
   CliResult r;
   r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
@@ -64,6 +68,15 @@ CliResult run_cli(const std::string& args) {
   r.out = slurp(dir / "out");
   r.err = slurp(dir / "err");
   return r;
+}
+
+}  // namespace
+
+CliResult run_cli(const std::string& args) { return run_command("", args); }
+
+CliResult run_cli_unprivileged(const std::string& args) {
+  // The output files are created by the shell before setpriv drops the privilege.
+  return run_command(::geteuid() == 0 ? "setpriv --reuid=65534 --regid=65534 --clear-groups -- " : "", args);
 }
 
 }  // namespace antpose::test

@@ -4,6 +4,8 @@
 #include <filesystem>
 #include <string>
 #include <string_view>
+#include <typeinfo>
+#include <utility>
 
 #include <gtest/gtest.h>
 
@@ -45,19 +47,29 @@ struct CliResult {
 /// Runs the antpose executable with the given argument string (shell syntax).
 CliResult run_cli(const std::string& args);
 
+/// As run_cli, but without the privilege to write where the file permissions forbid it: as
+/// nobody (setpriv) when the tests run as root, who may write anywhere.
+CliResult run_cli_unprivileged(const std::string& args);
+
 /// The antpose executable the tests run (for scripts that take it).
 std::filesystem::path cli_path();
+
+/// The message of the `E` that `f` throws; fails the calling test when it throws none.
+template <class E, class F>
+std::string error_message(F&& f) {
+  try {
+    f();
+  } catch (const E& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no " << typeid(E).name() << " thrown";
+  return "";
+}
 
 /// The message of the InputError that `f` throws; fails the calling test when it throws none.
 template <class F>
 std::string input_error(F&& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "no InputError thrown";
-  return "";
+  return error_message<InputError>(std::forward<F>(f));
 }
 
 }  // namespace antpose::test

@@ -41,6 +41,7 @@
 
 #include "antpose/calibration/board_reference.hpp"
 #include "antpose/camera/board_pose.hpp"
+#include "antpose/core/check.hpp"
 #include "antpose/core/error.hpp"
 #include "antpose/orientation/estimator.hpp"
 #include "antpose/store/device_profile.hpp"
@@ -188,6 +189,11 @@ struct ReferenceFreeOptions {
     gyro_cross_axis_sigma = 0.003;
   }
   bool gyro_uncalibrated() const { return gyro_scale_sigma > 0.0 || gyro_cross_axis_sigma > 0.0; }
+
+  /// What is wrong with the options: every value finite and in its range, the start (or fixed)
+  /// time offset inside the grid-search bracket, the gyroscope's error priors both 0 or both
+  /// positive.
+  OptionProblems Check() const;
 };
 
 struct PhotoResidual {

@@ -361,6 +361,33 @@ void warn_uncalibrated_gyroscope(ReferenceFreeCalibration& out, Diagnostics& dia
 
 }  // namespace
 
+OptionProblems ReferenceFreeOptions::Check() const {
+  OptionProblems p;
+  const auto finite = [](std::initializer_list<double> values) {
+    return std::all_of(values.begin(), values.end(), [](double v) { return std::isfinite(v); });
+  };
+  p.require(finite({time_offset_min_s, time_offset_max_s}) && time_offset_min_s < time_offset_max_s,
+            "time_offset_min_s, time_offset_max_s", "finite, min < max");
+  p.require(std::isfinite(time_offset_start_s) && time_offset_start_s >= time_offset_min_s &&
+                time_offset_start_s <= time_offset_max_s,
+            "time_offset_start_s", "finite, within [time_offset_min_s, time_offset_max_s]");
+  p.require(time_offset_step_s > 0.0 && max_time_offset_sigma_s > 0.0, "time_offset_step_s, max_time_offset_sigma_s",
+            "positive");
+  p.require(gyro_bias_sigma_rad_s > 0.0 && std::isfinite(gyro_bias_sigma_rad_s), "gyro_bias_sigma_rad_s",
+            "positive, finite");
+  p.require(std::isfinite(gyro_scale_sigma) && std::isfinite(gyro_cross_axis_sigma) &&
+                ((gyro_scale_sigma == 0.0 && gyro_cross_axis_sigma == 0.0) ||
+                 (gyro_scale_sigma > 0.0 && gyro_cross_axis_sigma > 0.0)),
+            "gyro_scale_sigma, gyro_cross_axis_sigma", "both 0 or both positive");
+  p.require(finite({min_rate_deg_s, min_view_change_deg, min_axis_spread_deg, gyro_noise_density, max_gyro_gap_s,
+                    default_pnp_sigma_deg, sigma_floor_deg, huber_k, outlier_chi2, min_outlier_deg}) &&
+                camera_rotation_sigma_rad.allFinite(),
+            "thresholds and noise levels", "finite");
+  p.require(min_photos_per_placement >= 2 && max_iterations >= 1, "min_photos_per_placement, max_iterations",
+            "at least 2 and 1");
+  return p;
+}
+
 ReferenceFreeCalibration calibrate_reference_free(const std::vector<PhotoObservation>& photos,
                                                   const orientation::SensorSeries& gyroscope,
                                                   const orientation::OrientationTrack& track,
@@ -370,12 +397,7 @@ ReferenceFreeCalibration calibrate_reference_free(const std::vector<PhotoObserva
   auto& warnings = out.warnings;
   if (gyroscope.size() < 2)
     throw MeasurementError("camera–IMU calibration: the gyroscope stream has fewer than 2 samples");
-  if (!(options.gyro_bias_sigma_rad_s > 0.0))
-    throw std::invalid_argument("calibrate_reference_free: gyro_bias_sigma_rad_s must be positive");
-  if (!(options.gyro_scale_sigma >= 0.0 && options.gyro_cross_axis_sigma >= 0.0) ||
-      (options.gyro_uncalibrated() && !(options.gyro_scale_sigma > 0.0 && options.gyro_cross_axis_sigma > 0.0)))
-    throw std::invalid_argument(
-        "calibrate_reference_free: gyro_scale_sigma and gyro_cross_axis_sigma must be both 0 or both positive");
+  throw_unless_ok(options.Check(), "ReferenceFreeOptions");
   const auto usable = photos_in_track(photos, track, 0.0, diagnostics, &warnings);
 
   // Group by placement (order of first appearance) and drop placements that cannot help.

@@ -1,4 +1,5 @@
 #include "antpose/camera/board_pose.hpp"
+#include "antpose/io/photo_file.hpp"
 
 #include <cmath>
 
@@ -154,10 +155,10 @@ std::vector<PhotoBoardPose> board_poses(const Capture& capture, const BoardSpec&
     const Shot& shot = capture.shots[i];
     PhotoBoardPose p{i, shot.t, shot.image, std::nullopt, {}, shot.extra, {}, {}};
     const auto file = capture.root / shot.image;
-    const cv::Mat image = cv::imread(file.string(), cv::IMREAD_UNCHANGED);
-    if (image.empty() || image.depth() != CV_8U) {
-      p.reason = image.empty() ? "unreadable image (missing, or not a JPEG/PNG that OpenCV can decode)"
-                               : "unsupported image (not 8 bits per channel)";
+    const io::Photo photo = io::read_photo(file, cv::IMREAD_UNCHANGED);
+    const cv::Mat& image = photo.image;
+    if (!photo.ok() || image.depth() != CV_8U) {
+      p.reason = !photo.ok() ? photo.problem : "unsupported image (not 8 bits per channel)";
     } else if (const auto mismatch = image_size_mismatch(image.cols, image.rows, intrinsics); !mismatch.empty()) {
       p.reason = mismatch;
     } else {

@@ -14,6 +14,7 @@
 #include "antpose/camera/board_pose.hpp"
 #include "antpose/io/text_file.hpp"
 #include "antpose/io/yaml_util.hpp"
+#include "antpose/io/photo_file.hpp"
 
 namespace antpose::camera {
 namespace fs = std::filesystem;
@@ -544,7 +545,7 @@ CameraCalibrationResult calibrate_camera(const Capture& capture, const Calibrati
                                          Diagnostics& diagnostics, const CalibrationProgress& progress) {
   // Board: the config's wins over board.yaml (the user chose the config for this run).
   std::optional<BoardSpec> board_file;
-  const fs::path board_path = capture.root / "board.yaml";
+  const fs::path board_path = capture_file(capture.root, "board.yaml");
   if (fs::exists(board_path)) board_file = read_board(board_path);
   BoardSpec board;
   if (settings.board) {
@@ -584,9 +585,10 @@ CameraCalibrationResult calibrate_camera(const Capture& capture, const Calibrati
       im.image = shot.image;
       CalibrationView view;
       view.name = shot.image;
-      cv::Mat image = cv::imread(file.string(), cv::IMREAD_UNCHANGED);
-      if (image.empty()) {
-        im.reason = "unreadable image (missing, or not a JPEG/PNG that OpenCV can decode)";
+      io::Photo photo = io::read_photo(file, cv::IMREAD_UNCHANGED);
+      cv::Mat image = std::move(photo.image);
+      if (!photo.ok()) {
+        im.reason = photo.problem;
       } else if (image.depth() != CV_8U) {
         im.reason = "unsupported image (not 8 bits per channel)";
       } else {

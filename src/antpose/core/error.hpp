@@ -35,6 +35,13 @@ class InputError : public Error {
   std::string detail_;
 };
 
+/// An output that cannot be written where the command line asks (a folder, a full disk, a
+/// folder without write permission): like bad input, it is fixed by changing the command.
+class OutputError : public InputError {
+ public:
+  using InputError::InputError;
+};
+
 /// Data that is well-formed but does not allow the requested computation
 /// (e.g. no static window in a contact capture).
 class MeasurementError : public Error {

@@ -167,7 +167,9 @@ std::optional<std::string> MagneticModel::validity_warning(double year) const {
 GeomagneticElements MagneticModel::evaluate(double lat_deg, double lon_deg, double alt_km, double year) const {
   if (!std::isfinite(lat_deg) || lat_deg < -90.0 || lat_deg > 90.0)
     throw std::invalid_argument(fmt::format("latitude {} deg is outside [-90, 90]", lat_deg));
-  if (!std::isfinite(lon_deg)) throw std::invalid_argument(fmt::format("longitude {} deg is not finite", lon_deg));
+  // Beyond one turn either way a longitude is a typing error, and at 1e16° its sine is noise.
+  if (!std::isfinite(lon_deg) || lon_deg < -360.0 || lon_deg > 360.0)
+    throw std::invalid_argument(fmt::format("longitude {} deg is outside [-360, 360]", lon_deg));
   if (!std::isfinite(alt_km) || alt_km < kMinAltitudeKm || alt_km > kMaxAltitudeKm)
     throw std::invalid_argument(fmt::format("height {} km is outside the model's range [{}, {}] km above the WGS84 "
                                             "ellipsoid",

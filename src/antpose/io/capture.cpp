@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <random>
 #include <set>
 
@@ -9,6 +10,7 @@
 
 #include "antpose/core/statistics.hpp"
 #include "antpose/io/csv.hpp"
+#include "antpose/io/file_access.hpp"
 #include "antpose/io/text_file.hpp"
 #include "antpose/io/time.hpp"
 #include "antpose/io/units.hpp"
@@ -123,6 +125,23 @@ void parse_metadata(Capture& c, const fs::path& file) {
 
 // --- tables -------------------------------------------------------------------------------
 
+// The x, y, z columns of a device-frame vector stream, found by name in whatever order the header
+// gives them (capture-format.md: columns are named, extras allowed); empty for other streams.
+std::vector<std::size_t> vector_columns(const io::CsvText& csv, std::string_view name) {
+  if (name != streams::kAccelerometer && name != streams::kGyroscope && name != streams::kMagnetometer) return {};
+  std::vector<std::size_t> out;
+  for (const char* axis : {"x", "y", "z"}) {
+    const auto j = csv.find_column(axis);
+    if (j < 0)
+      throw InputError(csv.file, 1,
+                       fmt::format("no column '{}': the {} stream has the columns {} (expected t,x,y,z; "
+                                   "extra columns are allowed)",
+                                   axis, name, fmt::join(csv.header, ",")));
+    out.push_back(static_cast<std::size_t>(j));
+  }
+  return out;
+}
+
 Stream parse_stream(const io::CsvText& csv, std::string name, io::NonFinite non_finite) {
   const std::size_t t_col = csv.column("t");
   Stream s;
@@ -130,12 +149,10 @@ Stream parse_stream(const io::CsvText& csv, std::string name, io::NonFinite non_
   s.gzip = io::is_gzip_name(csv.file);
   s.source_file = csv.file;
   s.source_lines = csv.lines;
-  std::vector<std::size_t> value_cols;
+  std::vector<std::size_t> value_cols = vector_columns(csv, s.name);
   for (std::size_t j = 0; j < csv.header.size(); ++j)
-    if (j != t_col) {
-      s.columns.push_back(csv.header[j]);
-      value_cols.push_back(j);
-    }
+    if (j != t_col && std::find(value_cols.begin(), value_cols.end(), j) == value_cols.end()) value_cols.push_back(j);
+  for (std::size_t j : value_cols) s.columns.push_back(csv.header[j]);
   s.t.resize(csv.rows.size());
   s.values.resize(static_cast<Eigen::Index>(csv.rows.size()), static_cast<Eigen::Index>(value_cols.size()));
   for (std::size_t i = 0; i < csv.rows.size(); ++i) {
@@ -175,6 +192,7 @@ void read_shots(Capture& c, const fs::path& folder) {
       extra.push_back(j);
       c.shot_extra_columns.push_back(csv.header[j]);
     }
+  std::map<fs::path, std::size_t> listed;  // image → its line
   for (std::size_t i = 0; i < csv.rows.size(); ++i) {
     const auto& row = csv.rows[i];
     const std::size_t line = csv.lines[i];
@@ -186,9 +204,19 @@ void read_shots(Capture& c, const fs::path& folder) {
     shot.source_line = line;
     shot.t = io::parse_number(row[ct], file, line, "t");
     shot.image = row[cimg];
-    if (shot.image.empty()) throw InputError(file, line, "column 'image' is empty, expected a path relative to the capture");
-    if (!fs::is_regular_file(folder / shot.image))
-      throw InputError(file, line, fmt::format("image '{}' not found in {}", shot.image, folder.string()));
+    const fs::path image = io::path_inside(folder, shot.image, {file, line, "image"});
+    // One row per photo: a photo listed twice would weigh twice in a calibration and pass for a
+    // second viewpoint in a measurement.
+    const auto [first, fresh] = listed.emplace(fs::path(shot.image).lexically_normal(), line);
+    if (!fresh)
+      throw InputError(file, line,
+                       fmt::format("image '{}' is listed again (first on line {}); each photo is one row", shot.image,
+                                   first->second));
+    if (const io::FileKind kind = io::file_kind(image); kind != io::FileKind::kRegular)
+      throw InputError(file, line,
+                       kind == io::FileKind::kMissing
+                           ? fmt::format("image '{}' not found in {}", shot.image, folder.string())
+                           : fmt::format("image '{}' is {}, expected a photo file", shot.image, io::describe(kind)));
     if (cexp >= 0 && !row[static_cast<std::size_t>(cexp)].empty())
       shot.exposure_s = io::parse_number(row[static_cast<std::size_t>(cexp)], file, line, "exposure_s");
     for (std::size_t j : extra) shot.extra.push_back(row[j]);
@@ -252,7 +280,11 @@ YAML::Node metadata_yaml(const Capture& c) {
 }
 
 fs::path truth_orientation_file(const fs::path& folder, const YAML::Node& truth) {
-  if (truth && truth.IsMap() && truth["orientation"]) return folder / truth["orientation"].as<std::string>();
+  if (truth && truth.IsMap() && truth["orientation"]) {
+    const fs::path yaml = folder / "capture.yaml";
+    const auto value = yaml_as<std::string>(truth["orientation"], yaml, "truth.orientation", "a path in the capture");
+    return io::path_inside(folder, value, {yaml, io::line_of(truth["orientation"]), "truth.orientation"});
+  }
   for (const char* name : {"truth/orientation.csv.gz", "truth/orientation.csv"})
     if (fs::exists(folder / name)) return folder / name;
   return {};
@@ -298,6 +330,19 @@ std::size_t Stream::source_line(std::size_t i) const {
   return source_file.empty() ? i + 2 : 0;
 }
 
+void require_android_frame(const Capture& capture, std::string_view what) {
+  if (capture.sensor_frame == "android") return;
+  throw InputError(capture.root / "capture.yaml",
+                   fmt::format("sensor_frame '{}': {} needs the streams in Android's device frame (x right, y up the "
+                               "long side, z out of the screen); a body frame that only the truth relates to the "
+                               "phone cannot give an antenna's attitude",
+                               capture.sensor_frame, what));
+}
+
+fs::path capture_file(const fs::path& folder, std::string_view name) {
+  return io::path_inside(folder, name, {folder, 0, "file"});
+}
+
 Capture read_capture(const fs::path& folder, Diagnostics& diagnostics, const CaptureReadOptions& options) {
   if (!fs::exists(folder)) throw InputError(folder, "capture folder not found");
   if (!fs::is_directory(folder)) throw InputError(folder, "is a file, expected a capture folder (with capture.yaml)");
@@ -311,14 +356,16 @@ Capture read_capture(const fs::path& folder, Diagnostics& diagnostics, const Cap
   if (fs::is_directory(folder / "sensors")) {
     std::vector<fs::path> files;
     for (const auto& e : fs::directory_iterator(folder / "sensors"))
-      if (e.is_regular_file() && !stream_stem(e.path()).empty()) files.push_back(e.path());
+      if (!e.is_directory() && !stream_stem(e.path()).empty()) files.push_back(e.path());
     std::sort(files.begin(), files.end());
     for (const auto& f : files) {
       std::string name = stream_stem(f);
       if (c.streams.contains(name))
         throw InputError(f, fmt::format("stream '{}' is stored twice (both .csv and .csv.gz); keep one", name));
+      const fs::path rel = f.lexically_relative(folder);  // fs::relative would follow the links
+      io::path_inside(folder, rel.string(), {folder / "sensors", 0, "stream"});
       c.streams.emplace(name, parse_stream(io::read_csv(f), name, io::NonFinite::kReject));
-      known.insert(fs::relative(f, folder));
+      known.insert(rel);
     }
   }
   if (fs::exists(folder / "shots.csv")) read_shots(c, folder);

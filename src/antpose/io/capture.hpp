@@ -122,6 +122,15 @@ struct CaptureReadOptions {
 Capture read_capture(const std::filesystem::path& folder, Diagnostics& diagnostics,
                      const CaptureReadOptions& options = {});
 
+/// InputError naming capture.yaml unless the streams are in Android's device frame, which the
+/// attitude of `what` ("the contact measurement") is defined in: with sensor_frame: other only
+/// the truth relates the axes to the phone, so an attitude read from them would be silently wrong.
+void require_android_frame(const Capture& capture, std::string_view what);
+
+/// `folder / name` for a file a capture holds by a fixed name (board.yaml), refused (InputError)
+/// when a symbolic link takes it out of the capture folder.
+std::filesystem::path capture_file(const std::filesystem::path& folder, std::string_view name);
+
 struct CaptureWriteOptions {
   bool overwrite = false;  // replace an existing folder (only after the new one is complete)
 };

@@ -1,6 +1,8 @@
 #include "antpose/measure/antenna_measurement.hpp"
 
 #include <algorithm>
+#include <array>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 
@@ -274,16 +276,30 @@ OptionProblems AntennaOptions::Check() const {
 
 AntennaRoi parse_roi(const std::string& text) {
   const auto colon = text.rfind(':');
-  AntennaRoi r;
-  int w = 0, h = 0, x = 0, y = 0;
-  char tail = 0;
-  if (colon == std::string::npos || colon == 0 ||
-      std::sscanf(text.c_str() + colon + 1, "%d,%d,%d,%d%c", &x, &y, &w, &h, &tail) != 4)
-    throw InputError("--roi", fmt::format("'{}' is not IMAGE:x,y,w,h (e.g. images/img_003.jpg:1200,300,400,1500, "
-                                          "pixels of that photo)",
-                                          text));
+  const auto malformed = [&] {
+    return InputError("--roi", fmt::format("'{}' is not IMAGE:x,y,w,h (e.g. images/img_003.jpg:1200,300,400,1500, "
+                                           "pixels of that photo)",
+                                           text));
+  };
+  if (colon == std::string::npos || colon == 0) throw malformed();
+  // std::from_chars, unlike sscanf's %d, says when a number does not fit an int.
+  std::array<int, 4> v{};
+  const char* p = text.data() + colon + 1;
+  const char* end = text.data() + text.size();
+  for (std::size_t k = 0; k < v.size(); ++k) {
+    if (k > 0 && (p == end || *p++ != ',')) throw malformed();
+    const auto [next, ec] = std::from_chars(p, end, v[k]);
+    if (ec == std::errc::result_out_of_range)
+      throw InputError("--roi", fmt::format("'{}': {} is far beyond any photo's pixels", text,
+                                            std::string_view(p, static_cast<std::size_t>(next - p))));
+    if (ec != std::errc()) throw malformed();
+    p = next;
+  }
+  if (p != end) throw malformed();
+  const auto [x, y, w, h] = v;
   if (x < 0 || y < 0 || w < 8 || h < 8)
     throw InputError("--roi", fmt::format("'{}': x and y must be ≥ 0 and the width and height at least 8 px", text));
+  AntennaRoi r;
   r.image = text.substr(0, colon);
   r.roi = {x, y, w, h};
   return r;

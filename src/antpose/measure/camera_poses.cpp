@@ -6,6 +6,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "antpose/camera/board_pose.hpp"
+#include "antpose/io/photo_file.hpp"
 
 namespace antpose::measure {
 namespace {
@@ -15,7 +16,7 @@ namespace {
 camera::CameraIntrinsics photo_intrinsics(const Capture& capture, const camera::CameraIntrinsics& calibrated,
                                           std::vector<std::string>& warnings) {
   for (const auto& shot : capture.shots) {
-    const cv::Mat image = cv::imread((capture.root / shot.image).string(), cv::IMREAD_GRAYSCALE);
+    const cv::Mat image = io::read_photo(capture.root / shot.image, cv::IMREAD_GRAYSCALE).image;
     if (image.empty()) continue;
     if (image.cols == calibrated.width && image.rows == calibrated.height) return calibrated;
     const auto rescaled = camera::rescaled_intrinsics(calibrated, image.cols, image.rows);
@@ -62,7 +63,7 @@ CameraPoses estimate_camera_poses(const Capture& capture, const camera::BoardSpe
     }
     reconstruction::PosedView v;
     v.name = fmt::format("shot {} ({})", p.shot_index, p.image);
-    v.image = cv::imread((capture.root / p.image).string(), cv::IMREAD_GRAYSCALE);
+    v.image = io::read_photo(capture.root / p.image, cv::IMREAD_GRAYSCALE).image;
     v.R_camera_board = p.pose->R_camera_board;
     v.t_camera_board = p.pose->t_camera_board;
     v.board_image_px = p.image_points_px;

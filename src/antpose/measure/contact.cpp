@@ -88,6 +88,7 @@ ContactResult measure_contact(const Capture& input, const ContactOptions& option
   // Fail on missing streams before anything else, with the capture's own message.
   input.require(streams::kAccelerometer);
   input.require(streams::kMagnetometer);
+  require_android_frame(input, "the contact measurement");
 
   const Capture* capture = &input;
   Capture calibrated;

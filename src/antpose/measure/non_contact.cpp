@@ -208,6 +208,7 @@ OptionProblems NonContactOptions::Check() const {
 NonContactResult measure_non_contact(const Capture& capture, const NonContactSetup& setup,
                                      const NonContactOptions& options, Diagnostics& diagnostics) {
   throw_unless_ok(options.Check(), "NonContactOptions");
+  require_android_frame(capture, "the non-contact measurement");
   if (setup.models.size() > 1 && setup.models.size() != setup.rois.size())
     throw InputError("--model", fmt::format("{} models for {} regions: give one model for all, or one per --roi in "
                                             "the same order",

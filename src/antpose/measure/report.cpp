@@ -13,6 +13,7 @@
 #include "antpose/io/report_text.hpp"
 #include "antpose/io/text_file.hpp"
 #include "antpose/model/mesh.hpp"
+#include "antpose/io/photo_file.hpp"
 
 namespace antpose::measure {
 namespace {
@@ -237,7 +238,7 @@ void write_report(const fs::path& folder, const Capture& capture, const NonConta
     std::vector<std::string> overlays;
     for (std::size_t i = 0; i < result.posed.size(); ++i) {
       const auto& shot = capture.shots[result.posed[i]];
-      cv::Mat image = cv::imread((capture.root / shot.image).string(), cv::IMREAD_COLOR);
+      cv::Mat image = io::read_photo(capture.root / shot.image, cv::IMREAD_COLOR).image;
       if (image.empty()) continue;
       const double scale = std::min(1.0, static_cast<double>(kOverlayWidth) / image.cols);
       if (scale < 1.0) cv::resize(image, image, cv::Size(), scale, scale, cv::INTER_AREA);

@@ -97,7 +97,7 @@ void StageClock::operator()(const std::string& stage, int, int) {
 SiteBenchmark benchmark_site(const std::filesystem::path& folder, const Capture& capture,
                              const std::vector<TruthAntenna>& truth, NonContactSetup setup,
                              const NonContactOptions& options, Diagnostics& diagnostics) {
-  setup.board = camera::read_board(folder / "board.yaml");
+  setup.board = camera::read_board(capture_file(folder, "board.yaml"));
   setup.models.clear();
   setup.rois.clear();
   for (const auto& t : truth) {

@@ -337,8 +337,8 @@ std::unique_ptr<OrientationEstimator> make_estimator(std::string_view name, cons
     }
     return e.create(full);
   }
-  throw InputError("--method", fmt::format("unknown orientation method '{}' (expected one of {})", name,
-                                           fmt::join(estimator_names(), ", ")));
+  throw InputError({}, fmt::format("unknown orientation method '{}' (expected one of {})", name,
+                                   fmt::join(estimator_names(), ", ")));
 }
 
 void write_track_csv(const OrientationTrack& track, const std::filesystem::path& file) {

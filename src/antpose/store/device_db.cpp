@@ -1,5 +1,7 @@
 #include "antpose/store/device_db.hpp"
 
+#include <unistd.h>
+
 #include <sqlite3.h>
 
 #include <algorithm>
@@ -218,19 +220,53 @@ fs::path DeviceDb::resolve_path(const std::optional<fs::path>& db) {
                            "--db PATH");
 }
 
-DeviceDb::DeviceDb(const fs::path& file) : file_(file) {
+namespace {
+
+// An SQLite URI for `file` (RFC 3986 escapes for the characters a URI path reserves).
+std::string read_only_uri(const fs::path& file, bool immutable) {
+  std::string uri = "file:";
+  for (const char c : fs::absolute(file).string())
+    if (c == '%' || c == '?' || c == '#')
+      uri += fmt::format("%{:02X}", static_cast<unsigned char>(c));
+    else
+      uri += c;
+  return uri + (immutable ? "?mode=ro&immutable=1" : "?mode=ro");
+}
+
+bool folder_writable(const fs::path& file) {
+  const fs::path folder = file.has_parent_path() ? file.parent_path() : fs::path(".");
+  return ::access(folder.c_str(), W_OK) == 0;
+}
+
+}  // namespace
+
+DeviceDb::DeviceDb(const fs::path& file, Access access) : file_(file) {
   if (fs::is_directory(file)) throw InputError(file, "is a folder; expected the device database file (e.g. devices.sqlite)");
-  if (file.has_parent_path()) {
+  if (access == Access::kReadOnly && !fs::exists(file))
+    throw InputError(file,
+                     "no device database here yet ('antpose device import' or a calibration with --device "
+                     "creates it)");
+  if (access == Access::kReadWrite && file.has_parent_path()) {
     std::error_code ec;
     fs::create_directories(file.parent_path(), ec);
     if (ec) throw InputError(file, fmt::format("cannot create the folder of the device database: {}", ec.message()));
   }
-  const int rc = sqlite3_open_v2(file.c_str(), &db_, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_NOMUTEX, nullptr);
+  open(access);
+}
+
+void DeviceDb::open(Access access) {
+  // Read-only in a folder nobody may write: no journal can appear beside the file, so nothing can
+  // change it, and SQLite may skip the locks and shared memory it could not create there.
+  const int rc = access == Access::kReadWrite
+                     ? sqlite3_open_v2(file_.c_str(), &db_,
+                                       SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_NOMUTEX, nullptr)
+                     : sqlite3_open_v2(read_only_uri(file_, !folder_writable(file_)).c_str(), &db_,
+                                       SQLITE_OPEN_READONLY | SQLITE_OPEN_URI | SQLITE_OPEN_NOMUTEX, nullptr);
   if (rc != SQLITE_OK) {
     const std::string detail = db_ ? sqlite3_errmsg(db_) : sqlite3_errstr(rc);
     sqlite3_close(db_);
     db_ = nullptr;
-    throw InputError(file, fmt::format("cannot open the device database: {}", detail));
+    throw InputError(file_, fmt::format("cannot open the device database: {}", detail));
   }
   try {
     sqlite3_extended_result_codes(db_, 1);
@@ -241,9 +277,15 @@ DeviceDb::DeviceDb(const fs::path& file) : file_(file) {
       s.step();
       const std::int64_t app = s.integer(0);
       if (app != 0 && app != kApplicationId)
-        throw InputError(file, fmt::format("is an SQLite database of another application (application_id {:#x}), not "
-                                           "an antpose device database",
-                                           app));
+        throw InputError(file_, fmt::format("is an SQLite database of another application (application_id {:#x}), not "
+                                            "an antpose device database",
+                                            app));
+    }
+    if (access == Access::kReadOnly) {
+      if (const int version = schema_version(); version != kSchemaVersion)
+        throw InputError(file_, fmt::format("device database schema version {} where this antpose reads {}{}", version,
+                                            kSchemaVersion, version > kSchemaVersion ? "; update antpose" : ""));
+      return;
     }
     // WAL: readers and one writer proceed concurrently, and a crash never leaves a torn write.
     // Switching the mode needs a moment without other connections, hence the retries.
@@ -257,11 +299,25 @@ DeviceDb::DeviceDb(const fs::path& file) : file_(file) {
     // NORMAL is durable in WAL mode except for the last transactions on power loss, never corrupt.
     exec(db_, file_, "PRAGMA synchronous=NORMAL");
     migrate();
+    require_intact();
   } catch (...) {
     sqlite3_close(db_);
     db_ = nullptr;
     throw;
   }
+}
+
+// A damaged file takes no writes: a run recorded into it could be lost with the damage, and the
+// user could not tell which profile is current. The database holds a few devices, so checking
+// every page (PRAGMA quick_check, O(N)) costs milliseconds.
+void DeviceDb::require_intact() const {
+  Statement s(db_, file_, "PRAGMA quick_check(1)");
+  s.step();
+  const std::string verdict = s.text(0);
+  if (verdict != "ok")
+    throw InputError(file_, fmt::format("the device database is corrupt ({}); nothing was written into it: restore it "
+                                        "from a backup, or move it aside and calibrate again",
+                                        verdict));
 }
 
 DeviceDb::~DeviceDb() { sqlite3_close(db_); }

@@ -76,9 +76,15 @@ class DeviceDb {
   /// The file to use: `db` when given, else the environment chain above.
   static std::filesystem::path resolve_path(const std::optional<std::filesystem::path>& db);
 
-  /// Opens (creating or migrating) the database. InputError naming the file when it is not an
-  /// SQLite file, corrupt, another application's database or of a newer schema.
-  explicit DeviceDb(const std::filesystem::path& file);
+  /// kReadWrite creates or migrates the file and refuses a damaged one (nothing is written into
+  /// it); kReadOnly neither creates nor changes anything, so that listing and reading work in a
+  /// folder without write permission.
+  enum class Access { kReadWrite, kReadOnly };
+
+  /// Opens the database. InputError naming the file when it is not an SQLite file, corrupt
+  /// (kReadWrite checks every page first), another application's database, of a newer schema,
+  /// or missing (kReadOnly).
+  explicit DeviceDb(const std::filesystem::path& file, Access access = Access::kReadWrite);
   ~DeviceDb();
   DeviceDb(const DeviceDb&) = delete;
   DeviceDb& operator=(const DeviceDb&) = delete;
@@ -116,7 +122,9 @@ class DeviceDb {
   int schema_version() const;
 
  private:
+  void open(Access access);
   void migrate();
+  void require_intact() const;
   [[noreturn]] void fail_missing(const std::string& id) const;
 
   std::filesystem::path file_;

@@ -38,7 +38,7 @@ DeviceRef resolve_device_ref(const std::string& arg, const std::optional<fs::pat
   const fs::path db_file = DeviceDb::resolve_path(db);
   const bool db_exists = fs::exists(db_file);
   if (is_file) {
-    if (db_exists && DeviceDb(db_file).has_device(arg))
+    if (db_exists && DeviceDb(db_file, DeviceDb::Access::kReadOnly).has_device(arg))
       throw InputError(path, fmt::format("--device '{}' is ambiguous: both a file in the current folder and a device id "
                                          "in {}; write ./{} for the file or use the id from another folder",
                                          arg, db_file.string(), arg));
@@ -55,7 +55,7 @@ DeviceRef resolve_device_ref(const std::string& arg, const std::optional<fs::pat
     throw InputError(db_file, fmt::format("--device '{}' is neither a file nor a device id: the device database does not "
                                           "exist yet (import a profile with 'antpose device import FILE.yaml')",
                                           arg));
-  return {DeviceDb(db_file).profile(arg), std::nullopt, db_file};
+  return {DeviceDb(db_file, DeviceDb::Access::kReadOnly).profile(arg), std::nullopt, db_file};
 }
 
 DeviceProfile resolve_device(const std::string& arg, const std::optional<fs::path>& db) {
