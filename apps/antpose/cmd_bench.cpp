@@ -23,6 +23,7 @@
 #include "antpose/orientation/orientation_benchmark.hpp"
 #include "antpose/orientation/rest_benchmark.hpp"
 #include "commands.hpp"
+#include "json_output.hpp"
 
 namespace antpose::cli {
 
@@ -178,8 +179,8 @@ void run_orientation_bench(const OrientationBenchArgs& args) {
                                 {"methods", methods},
                                 {"trials", jt},
                                 {"means", means}};
-    io::write_text_atomic(args.json, out.dump(2) + "\n");
-    fmt::print("\nJSON written to {}\n", args.json);
+    write_json(args.json, out);
+    if (args.json != "-") fmt::print("\nJSON written to {}\n", args.json);
   }
   print_warnings(diagnostics);
 }
@@ -283,7 +284,7 @@ void add_bench_command(CLI::App& app) {
   ob->add_option("--methods", oargs->methods,
                  fmt::format("comma-separated estimators (default: all: {})",
                              fmt::join(orientation::estimator_names(), ",")));
-  ob->add_option("--json", oargs->json, "write the per-trial and mean results as JSON");
+  add_json_option(ob, oargs->json, "write the per-trial and mean results");
   ob->add_option("--wmm", oargs->wmm, "extra WMM coefficient files for the declination (repeatable; with the built-in "
                                       "WMM2025, the model valid for the capture date is used, else the nearest epoch)");
   ob->add_option("--skip-s", oargs->skip_s, "truth without a moving column: seconds left out at its start")

@@ -2,7 +2,6 @@
 //   antpose bench measure DIR... --device ID|FILE [--db DB] [--json OUT]
 // Each capture is measured with every antenna of its truth/scene.yaml (rectangle and built-in
 // model) at once, as `antpose measure` would; the speed target is per site (docs/benchmarks.md).
-#include <unistd.h>
 
 #include <algorithm>
 #include <cstdio>
@@ -21,6 +20,8 @@
 #include "antpose/measure/site_benchmark.hpp"
 #include "antpose/store/device_ref.hpp"
 #include "commands.hpp"
+#include "json_output.hpp"
+#include "progress.hpp"
 
 namespace antpose::cli {
 namespace {
@@ -68,13 +69,9 @@ void run_measure_bench(const MeasureBenchArgs& args) {
     Capture capture = read_capture(folder, diagnostics);
     if (ref.profile.has_imu) imu::apply(ref.profile.imu, capture);
     measure::NonContactOptions options;
-    if (isatty(fileno(stderr)))
-      options.progress = [&](const std::string& stage, int done, int total) {
-        fmt::print(stderr, "\r\033[K{}: {} {}/{}", folder.filename().string(), stage, done, total);
-        std::fflush(stderr);
-      };
+    ProgressLine progress(folder.filename().string());
+    options.progress = progress.callback();
     const auto site = measure::benchmark_site(folder, capture, truth, setup, options, diagnostics);
-    if (options.progress) fmt::print(stderr, "\r\033[K");
     print_site(site);
     seconds.push_back(site.seconds);
     sites.push_back(measure::to_json(site));
@@ -83,7 +80,7 @@ void run_measure_bench(const MeasureBenchArgs& args) {
   if (!seconds.empty())
     fmt::print("{} sites: median {:.1f} s, slowest {:.1f} s per site\n", seconds.size(), seconds[seconds.size() / 2],
                seconds.back());
-  if (!args.json.empty()) io::write_text_atomic(args.json, nlohmann::json{{"sites", sites}}.dump(2) + "\n");
+  write_json(args.json, nlohmann::json{{"sites", sites}});
 }
 
 }  // namespace
@@ -96,7 +93,7 @@ void add_bench_measure_command(CLI::App& bench) {
   cmd->add_option("--device", args->device, "the phone: a device id in the database or a profile YAML file")
       ->required();
   cmd->add_option("--db", args->db, "device database (default as 'antpose device')");
-  cmd->add_option("--json", args->json, "write the per-site results as JSON");
+  add_json_option(cmd, args->json, "write the per-site results");
   cmd->callback([args] { run_measure_bench(*args); });
 }
 

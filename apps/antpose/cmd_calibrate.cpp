@@ -13,6 +13,7 @@
 #include "antpose/calibration/calibrate_imu.hpp"
 #include "antpose/io/text_file.hpp"
 #include "commands.hpp"
+#include "json_output.hpp"
 #include "device_calibration.hpp"
 
 namespace antpose::cli {
@@ -131,7 +132,7 @@ void run_allan(const AllanArgs& args) {
     j["axes"].push_back(axis);
     series.push_back({args.stream + " " + a.axes[k], a.curves[k], f});
   }
-  if (!args.json.empty()) io::write_text_atomic(args.json, j.dump(2) + "\n");
+  write_json(args.json, j);
   if (!args.plot.empty())
     io::write_text_atomic(args.plot,
                           calibration::allan_svg(series, "Overlapping Allan deviation: " + args.capture, unit));
@@ -167,7 +168,7 @@ void add_calibrate_command(CLI::App& app) {
   auto* allan = cmd->add_subcommand("allan", "overlapping Allan deviation and noise fit of a static log");
   allan->add_option("capture", allan_args->capture, "capture folder (a long static recording)")->required();
   allan->add_option("--stream", allan_args->stream, "stream to analyse")->capture_default_str();
-  allan->add_option("--json", allan_args->json, "write the curves and fits as JSON");
+  add_json_option(allan, allan_args->json, "write the curves and fits");
   allan->add_option("--plot", allan_args->plot, "write a log-log SVG plot");
   allan->add_option("--per-decade", allan_args->per_decade, "averaging times per decade")->capture_default_str();
   allan->callback([allan_args] { run_allan(*allan_args); });

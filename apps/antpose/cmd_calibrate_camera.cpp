@@ -12,6 +12,7 @@
 #include "antpose/camera/calibrate_camera.hpp"
 #include "antpose/io/text_file.hpp"
 #include "commands.hpp"
+#include "json_output.hpp"
 #include "device_calibration.hpp"
 
 namespace antpose::cli {
@@ -94,7 +95,7 @@ void run_camera(const CameraArgs& args) {
       camera::write_camera_file(args.output, result, args.force);
       fmt::print("wrote {}\n", args.output);
     }
-    if (!args.json.empty()) io::write_text_atomic(args.json, to_json(result).dump(2) + "\n");
+    write_json(args.json, to_json(result));
     CalibrationOutcome outcome;
     outcome.residuals = {{"rms_px", result.rms_px},
                          {"photos_used", result.used_count()},
@@ -129,7 +130,7 @@ void add_calibrate_camera_command(CLI::App& calibrate) {
   cmd->add_option("-o,--output", args->output, "camera YAML to write (OpenCV FileStorage; required without --device)");
   args->device.add_to(*cmd);
   cmd->add_flag("--force", args->force, "replace an existing output file");
-  cmd->add_option("--json", args->json, "also write the result as JSON");
+  add_json_option(cmd, args->json, "also write the result");
   cmd->callback([args] { run_camera(*args); });
 }
 

@@ -21,6 +21,8 @@
 #include "antpose/io/text_file.hpp"
 #include "antpose/orientation/estimator.hpp"
 #include "commands.hpp"
+#include "json_output.hpp"
+#include "progress.hpp"
 #include "device_calibration.hpp"
 
 namespace antpose::cli {
@@ -82,28 +84,39 @@ CalibrationOutcome joint_calibration(const JointArgs& args, const std::optional<
                      "the time offset; run 'antpose calibrate imu --device' first");
   }
   const fs::path root = args.capture;
-  const auto board = camera::read_board(root / "board.yaml");
+  const auto board = camera::read_board(capture_file(root, "board.yaml"));
   const auto camera_info = joint_intrinsics(args, device);
   const auto& intrinsics = camera_info.intrinsics;
   const auto placements = calibration::shot_placements(capture);
   std::optional<calibration::BoardReference> reference;
   for (const char* name : {"board_reference.csv", "board_reference.csv.gz"})
-    if (fs::is_regular_file(root / name)) {
-      reference = calibration::read_board_reference(root / name);
+    if (fs::exists(root / name)) {
+      reference = calibration::read_board_reference(capture_file(root, name));
       calibration::check_board_reference(*reference, placements);
       break;
     }
   if (args.method == "thesis" && !reference)
     throw InputError(root / "board_reference.csv", "missing: the thesis method needs the level/compass angles");
 
+  // The stages take up to a minute: each is reported as it ends (progress.hpp).
+  ProgressLine progress;
+  const auto stage = [report = progress.callback()](const char* name, std::size_t done, std::size_t total) {
+    if (report) report(name, static_cast<int>(done), static_cast<int>(total));
+  };
+  stage("board poses", 0, 1);
   const auto poses = camera::board_poses(capture, board, intrinsics, diagnostics);
+  stage("board poses", 1, 1);
   const auto photos = calibration::photo_observations(capture, poses);
   fmt::print("{} of {} photos with a board pose\n", photos.size(), capture.shots.size());
 
   const auto data = orientation::imu_data_from_capture(capture, diagnostics);
   const auto params = orientation::parse_params(args.params);
   std::vector<orientation::OrientationTrack> tracks;
-  for (const auto& m : methods) tracks.push_back(orientation::make_estimator(m, params)->estimate(data, diagnostics));
+  stage("phone orientation", 0, methods.size());
+  for (const auto& m : methods) {
+    tracks.push_back(orientation::make_estimator(m, params)->estimate(data, diagnostics));
+    stage("phone orientation", tracks.size(), methods.size());
+  }
 
   nlohmann::json j;
   j["capture"] = args.capture;
@@ -121,8 +134,10 @@ CalibrationOutcome joint_calibration(const JointArgs& args, const std::optional<
           calibration::principal_point_rotation_sigma(intrinsics, *camera_info.principal_point_sigma_px);
     else
       fmt::print("(the intrinsics give no principal-point σ: the rotation σ below leaves out their error)\n");
+    stage("camera–IMU rotation", 0, 1);
     const auto r = calibration::calibrate_reference_free(photos, data.gyroscope, tracks.front(), options, diagnostics,
                                                          reference ? &*reference : nullptr);
+    stage("camera–IMU rotation", 1, 1);
     offset_for_thesis = r.time_offset_s;
     stored = r.to_profile();
     outcome.residuals = {{"method", "reference-free"},
@@ -211,7 +226,7 @@ CalibrationOutcome joint_calibration(const JointArgs& args, const std::optional<
                            {"azimuth_error_deg", r.optimised.overall.azimuth_error_deg}};
     }
   }
-  if (!args.json.empty()) io::write_text_atomic(args.json, j.dump(2) + "\n");
+  write_json(args.json, j);
   if (!stored) throw MeasurementError("camera–IMU calibration: no method produced a result");
   outcome.apply = [c = *stored](store::DeviceProfile& current) { current.camera_imu = c; };
   return outcome;
@@ -258,10 +273,13 @@ void add_calibrate_joint_command(CLI::App& calibrate) {
                   "tables list each")
       ->capture_default_str();
   cmd->add_option("--param", args->params, "orientation parameter name=value (repeatable)");
-  cmd->add_option("--time-offset", args->time_offset, "start (or fixed) camera–IMU time offset, s")
-      ->capture_default_str();
+  const calibration::ReferenceFreeOptions defaults;
+  cmd->add_option("--time-offset", args->time_offset,
+                  "start (or fixed) camera–IMU time offset, s, within the estimate's search bracket")
+      ->capture_default_str()
+      ->check(finite_within(defaults.time_offset_min_s, defaults.time_offset_max_s, "s"));
   cmd->add_flag("--fixed-time-offset", args->fixed_time_offset, "do not estimate the time offset");
-  cmd->add_option("--json", args->json, "also write the result as JSON");
+  add_json_option(cmd, args->json, "also write the result");
   cmd->callback([args] { run_joint(*args); });
 }
 

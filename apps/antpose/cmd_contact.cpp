@@ -10,6 +10,8 @@
 #include "antpose/io/text_file.hpp"
 #include "antpose/measure/contact.hpp"
 #include "commands.hpp"
+#include "json_output.hpp"
+#include "usable.hpp"
 
 namespace antpose::cli {
 namespace {
@@ -20,6 +22,7 @@ struct ContactArgs {
   std::string calibration;
   std::string placement = "top-up";
   std::string json;
+  double max_sigma_deg = kDefaultMaxSigmaDeg;
   bool no_unit_repair = false;
 };
 
@@ -46,7 +49,16 @@ std::string angle(const std::optional<double>& value, double sigma, int digits) 
   return fmt::format("{:.{}f}° ± {:.{}f}°", rad2deg(*value), digits, rad2deg(sigma), digits);
 }
 
-void run_contact(const ContactArgs& args) {
+// The azimuth that is reported (true with a site, else magnetic), the downtilt and the roll.
+std::vector<AngleReading> readings(const measure::ContactResult& r) {
+  const bool truth = r.azimuth_true.has_value();
+  return {{truth ? "azimuth" : "magnetic azimuth", truth ? r.azimuth_true : r.azimuth_magnetic,
+           truth ? r.sigma.azimuth_true : std::optional<double>(r.sigma.azimuth)},
+          {"downtilt", r.downtilt, r.sigma.downtilt},
+          {"roll", r.roll, r.sigma.roll}};
+}
+
+int run_contact(const ContactArgs& args) {
   measure::ContactOptions options;
   try {
     options.placement = parse_contact_placement(args.placement);
@@ -90,7 +102,12 @@ void run_contact(const ContactArgs& args) {
   for (const auto& w : r.warnings) result_warnings.warn(w);
   print_warnings(result_warnings);
 
-  if (!args.json.empty()) io::write_text_atomic(args.json, measure::to_json(r).dump(2) + "\n");
+  write_json(args.json, measure::to_json(r));
+  if (const std::string why = unusable_reason(readings(r), args.max_sigma_deg); !why.empty()) {
+    fmt::print(stderr, "warning: the result is not usable: {}\n", why);
+    return kExitPartial;
+  }
+  return kExitOk;
 }
 
 }  // namespace
@@ -104,9 +121,12 @@ void add_contact_command(CLI::App& app) {
                   "or an antpose-device YAML file");
   cmd->add_option("--placement", args->placement, "how the phone lies on the plate: top-up, top-down, top-right, top-left")
       ->capture_default_str();
-  cmd->add_option("--json", args->json, "write the result as JSON to this file");
+  add_json_option(cmd, args->json, "write the result");
+  add_max_sigma_option(cmd, args->max_sigma_deg);
   cmd->add_flag("--no-unit-repair", args->no_unit_repair, "treat streams in the wrong unit as errors");
-  cmd->callback([args] { run_contact(*args); });
+  cmd->callback([args] {
+    if (const int status = run_contact(*args); status != kExitOk) throw CLI::RuntimeError(status);
+  });
 }
 
 }  // namespace antpose::cli

@@ -1,6 +1,6 @@
 // antpose device: the device database (docs/devices.md).
 //   antpose device list [--db PATH]
-//   antpose device show ID [--history] [--json] [--db PATH]
+//   antpose device show ID [--history] [--json FILE|-] [--db PATH]
 //   antpose device export ID -o FILE.yaml [--force] [--db PATH]
 //   antpose device import FILE.yaml [--id ID] [--model M] [--db PATH]
 //   antpose device remove ID [--db PATH]
@@ -13,6 +13,7 @@
 
 #include "antpose/store/device_db.hpp"
 #include "commands.hpp"
+#include "json_output.hpp"
 
 namespace antpose::cli {
 namespace {
@@ -20,17 +21,24 @@ namespace fs = std::filesystem;
 
 struct DeviceArgs {
   std::optional<std::string> db;
-  std::string id, file, output;
+  std::string id, file, output, json;
   std::optional<std::string> import_id, model;
-  bool history = false, json = false, force = false;
+  bool history = false, force = false;
 
   std::optional<fs::path> db_path() const { return db ? std::optional<fs::path>(*db) : std::nullopt; }
 };
 
-store::DeviceDb open_db(const DeviceArgs& a) { return store::DeviceDb(store::DeviceDb::resolve_path(a.db_path())); }
+store::DeviceDb open_db(const DeviceArgs& a, store::DeviceDb::Access access = store::DeviceDb::Access::kReadWrite) {
+  return store::DeviceDb(store::DeviceDb::resolve_path(a.db_path()), access);
+}
 
 void run_list(const DeviceArgs& a) {
-  const store::DeviceDb db(store::DeviceDb::resolve_path(a.db_path()));
+  const fs::path file = store::DeviceDb::resolve_path(a.db_path());
+  if (!fs::exists(file)) {
+    fmt::print("no devices: there is no device database at {} yet\n", file.string());
+    return;
+  }
+  const store::DeviceDb db(file, store::DeviceDb::Access::kReadOnly);
   const auto devices = db.list_devices();
   if (devices.empty()) {
     fmt::print("no devices in {}\n", db.path().string());
@@ -50,16 +58,16 @@ nlohmann::json run_json(const store::CalibrationRun& r) {
 }
 
 void run_show(const DeviceArgs& a) {
-  const store::DeviceDb db(store::DeviceDb::resolve_path(a.db_path()));
+  const store::DeviceDb db = open_db(a, store::DeviceDb::Access::kReadOnly);
   const store::DeviceProfile profile = db.profile(a.id);
   const std::string yaml = store::format_device_profile(profile);
-  if (a.json) {
+  if (!a.json.empty()) {
     nlohmann::json j{{"id", profile.id}, {"model", profile.model}, {"profile_yaml", yaml}};
     if (a.history) {
       j["history"] = nlohmann::json::array();
       for (const auto& r : db.history(a.id)) j["history"].push_back(run_json(r));
     }
-    fmt::print("{}\n", j.dump(2));
+    write_json(a.json, j);
     return;
   }
   fmt::print("{}", yaml);
@@ -73,7 +81,7 @@ void run_show(const DeviceArgs& a) {
 }
 
 void run_export(const DeviceArgs& a) {
-  open_db(a).export_profile(a.id, a.output, a.force);
+  open_db(a, store::DeviceDb::Access::kReadOnly).export_profile(a.id, a.output, a.force);
   fmt::print("wrote {}\n", a.output);
 }
 
@@ -108,7 +116,7 @@ void add_device_command(CLI::App& app) {
   auto* show = cmd->add_subcommand("show", "the current profile of a device (YAML), optionally its calibration history");
   show->add_option("id", a->id, "device id")->required();
   show->add_flag("--history", a->history, "also list the calibration runs");
-  show->add_flag("--json", a->json, "print JSON instead");
+  add_json_option(show, a->json, "write the profile (and --history) instead of printing YAML");
   add_db_option(show, *a);
   show->callback([a] { run_show(*a); });
 

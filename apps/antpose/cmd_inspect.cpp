@@ -8,6 +8,7 @@
 #include "antpose/io/inspect.hpp"
 #include "antpose/io/text_file.hpp"
 #include "commands.hpp"
+#include "json_output.hpp"
 
 namespace antpose::cli {
 
@@ -29,7 +30,7 @@ void run_inspect(const InspectOptions& o) {
   summary.format = std::string(to_string(format));
   print_warnings(diagnostics);
   fmt::print("{}", format_summary(summary));
-  if (!o.json.empty()) io::write_text_atomic(o.json, to_json(summary).dump(2) + "\n");
+  write_json(o.json, to_json(summary));
 }
 
 }  // namespace
@@ -38,7 +39,7 @@ void add_inspect_command(CLI::App& app) {
   auto opts = std::make_shared<InspectOptions>();
   auto* cmd = app.add_subcommand("inspect", "Summarize a capture: streams, rates, jitter, gaps, statistics, shots, truth");
   cmd->add_option("CAPTURE", opts->capture, "Capture folder or export (any layout convert reads)")->required();
-  cmd->add_option("--json", opts->json, "Also write the summary as JSON to this file");
+  add_json_option(cmd, opts->json, "also write the summary");
   cmd->add_flag("--no-unit-repair", opts->no_unit_repair, "Refuse streams in the wrong unit instead of converting them");
   cmd->callback([opts] { run_inspect(*opts); });
 }

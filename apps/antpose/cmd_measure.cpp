@@ -2,7 +2,6 @@
 //   antpose measure CAPTURE --device ID|FILE [--model MESH|BUILTIN [--model-box BOX] [--model-units m|mm]]
 //       --roi IMAGE:x,y,w,h [--roi ...] [--json OUT] [--report DIR [--force]]
 #include <algorithm>
-#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -19,8 +18,12 @@
 #include "antpose/measure/non_contact.hpp"
 #include "antpose/measure/report.hpp"
 #include "antpose/model/antenna_model.hpp"
+#include "antpose/orientation/estimator.hpp"
 #include "antpose/store/device_ref.hpp"
 #include "commands.hpp"
+#include "json_output.hpp"
+#include "progress.hpp"
+#include "usable.hpp"
 
 namespace antpose::cli {
 namespace {
@@ -28,6 +31,7 @@ namespace fs = std::filesystem;
 
 struct MeasureArgs {
   std::string capture, device, model_units = "m", json, report, orientation = "antpose-smoother";
+  double max_sigma_deg = kDefaultMaxSigmaDeg;
   std::optional<std::string> db;
   std::vector<std::string> rois, models, model_boxes;
   bool model_canonical = false, force = false;
@@ -67,7 +71,7 @@ std::vector<model::AntennaModel> load_models(const MeasureArgs& a) {
 
 measure::NonContactSetup setup_from(const MeasureArgs& a, const store::DeviceProfile& device, const fs::path& where) {
   measure::NonContactSetup s = measure::device_setup(device, where);
-  s.board = camera::read_board(fs::path(a.capture) / "board.yaml");
+  s.board = camera::read_board(capture_file(a.capture, "board.yaml"));
   s.models = load_models(a);
   for (const auto& r : a.rois) s.rois.push_back(measure::parse_roi(r));
   return s;
@@ -102,6 +106,33 @@ void print_table(const measure::NonContactResult& r) {
   }
 }
 
+// 3 when no antenna was measured; 4 when one failed or has an angle that is not usable (each said
+// on stderr); 0 otherwise.
+int exit_status(const measure::NonContactResult& r, double max_sigma_deg) {
+  std::size_t failed = 0, unusable = 0;
+  for (std::size_t k = 0; k < r.antennas.size(); ++k) {
+    const auto& m = r.antennas[k];
+    if (m.error) {
+      ++failed;
+      continue;
+    }
+    const auto& a = m.attitude;
+    const bool truth = a.azimuth_true.has_value();
+    const std::string why =
+        unusable_reason({{truth ? "azimuth" : "magnetic azimuth", truth ? a.azimuth_true : a.magnetic.azimuth,
+                          truth ? a.azimuth_true_sigma : a.sigma.azimuth},
+                         {"downtilt", a.magnetic.downtilt, a.sigma.downtilt},
+                         {"roll", a.magnetic.roll, a.sigma.roll}},
+                        max_sigma_deg);
+    if (!why.empty()) {
+      ++unusable;
+      fmt::print(stderr, "warning: antenna {} is not usable: {}\n", k + 1, why);
+    }
+  }
+  if (failed == r.antennas.size()) return kExitUnsupported;
+  return failed + unusable > 0 ? kExitPartial : kExitOk;
+}
+
 int run_measure(const MeasureArgs& a) {
   if (a.rois.empty())
     throw InputError("--roi", "at least one --roi IMAGE:x,y,w,h is needed (the antenna in one photo)");
@@ -123,13 +154,8 @@ int run_measure(const MeasureArgs& a) {
 
   measure::NonContactOptions options;
   options.world.orientation = a.orientation;
-  const auto start = std::chrono::steady_clock::now();
-  options.progress = [&](const std::string& stage, int done, int total) {
-    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    fmt::print(stderr, "\r\033[K[{:5.1f} s] {} {}/{}", s, stage, done, total);
-    if (done == total) fmt::print(stderr, "\n");
-    std::fflush(stderr);
-  };
+  ProgressLine progress;
+  options.progress = progress.callback();
   const auto result = measure::measure_non_contact(capture, setup, options, diagnostics);
   print_warnings(diagnostics);
   print_table(result);
@@ -144,14 +170,12 @@ int run_measure(const MeasureArgs& a) {
     for (const auto& w : m.warnings) result_warnings.warn(fmt::format("antenna {}: {}", k + 1, w));
   }
   print_warnings(result_warnings);
-  if (!a.json.empty()) io::write_text_atomic(a.json, measure::to_json(result).dump(2) + "\n");
+  write_json(a.json, measure::to_json(result));
   if (!a.report.empty()) {
     measure::write_report(a.report, capture, setup, result, a.force);
     fmt::print("report: {}\n", (fs::path(a.report) / "index.html").string());
   }
-  for (const auto& m : result.antennas)
-    if (m.error) return 3;
-  return 0;
+  return exit_status(result, a.max_sigma_deg);
 }
 
 }  // namespace
@@ -174,10 +198,13 @@ void add_measure_command(CLI::App& app) {
   cmd->add_flag("--model-canonical", a->model_canonical, "the mesh is already in the antenna frame (no box file)");
   cmd->add_option("--roi", a->rois, "IMAGE:x,y,w,h: the antenna's rectangle in one photo (px); once per antenna")
       ->required();
-  cmd->add_option("--orientation", a->orientation, "phone orientation method")->capture_default_str();
-  cmd->add_option("--json", a->json, "write the result as JSON to this file");
+  cmd->add_option("--orientation", a->orientation, "phone orientation method")
+      ->capture_default_str()
+      ->check(CLI::IsMember(orientation::estimator_names()));
+  add_json_option(cmd, a->json, "write the result");
   cmd->add_option("--report", a->report, "write a report folder (HTML, overlays, PLY clouds)");
   cmd->add_flag("--force", a->force, "replace an existing report folder");
+  add_max_sigma_option(cmd, a->max_sigma_deg);
   cmd->callback([a] {
     const int status = run_measure(*a);
     if (status != 0) throw CLI::RuntimeError(status);

@@ -173,23 +173,31 @@ void add_simulate_command(CLI::App& app) {
                   "tumble: continuous random rotations (magnetometer calibration, kind imu-calibration); contact: phone laid on an antenna's back plate (kind contact)")
       ->check(CLI::IsMember({"contact", "static-poses", "tumble"}))
       ->capture_default_str();
-  cmd->add_option("--duration", o->duration_s,
-                  "Total length, s (static-poses: 79.5; tumble: 30; contact: 14.5, of which all but 6.5 s on the plate)");
+  cmd->add_option(
+         "--duration", o->duration_s,
+         "Total length, s (static-poses: 79.5; tumble: 30; contact: 14.5, of which all but 6.5 s on the plate)")
+      ->check(finite_within(0.0, 86400.0, "s"));
   cmd->add_option("--phone", o->phone, "Sensor error model: ideal, typical (datasheet figures), random (a unit within tolerance)")
       ->check(CLI::IsMember({"ideal", "typical", "random"}))
       ->capture_default_str();
   cmd->add_option("--hard-iron-uT", o->hard_iron, "Magnetometer hard iron X,Y,Z in µT (replaces the phone model's)");
   cmd->add_option("--disturbance-uT", o->disturbance, "Extra magnetic field X,Y,Z (µT, ENU) during --disturbance-window");
   cmd->add_option("--disturbance-window", o->disturbance_window, "T0,T1: when the disturbance is present, s");
-  cmd->add_option("--lat", o->lat_deg, "Site latitude, deg (with --lon: Earth field from WMM2025, normal gravity)");
-  cmd->add_option("--lon", o->lon_deg, "Site longitude, deg east");
-  cmd->add_option("--alt-m", o->alt_m, "Site height above the WGS84 ellipsoid, m");
+  cmd->add_option("--lat", o->lat_deg, "Site latitude, deg (with --lon: Earth field from WMM2025, normal gravity)")
+      ->check(finite_within(-90.0, 90.0, "deg"));
+  cmd->add_option("--lon", o->lon_deg, "Site longitude, deg east")->check(finite_within(-360.0, 360.0, "deg"));
+  cmd->add_option("--alt-m", o->alt_m, "Site height above the WGS84 ellipsoid, m")
+      ->check(finite_within(-1000.0, 850000.0, "m"));
   cmd->add_option("--date", o->date, "Date YYYY-MM-DD for the magnetic model (default today)");
-  cmd->add_option("--antenna-azimuth-deg", o->azimuth_deg, "Contact preset: true azimuth of the antenna boresight, deg");
-  cmd->add_option("--antenna-downtilt-deg", o->downtilt_deg, "Contact preset: mechanical downtilt, deg (positive down)");
-  cmd->add_option("--antenna-roll-deg", o->roll_deg, "Contact preset: roll about the boresight, deg");
+  cmd->add_option("--antenna-azimuth-deg", o->azimuth_deg, "Contact preset: true azimuth of the antenna boresight, deg")
+      ->check(finite_within(-360.0, 360.0, "deg"));
+  cmd->add_option("--antenna-downtilt-deg", o->downtilt_deg, "Contact preset: mechanical downtilt, deg (positive down)")
+      ->check(finite_within(-90.0, 90.0, "deg"));
+  cmd->add_option("--antenna-roll-deg", o->roll_deg, "Contact preset: roll about the boresight, deg")
+      ->check(finite_within(-180.0, 180.0, "deg"));
   cmd->add_option("--placement", o->placement, "Contact preset: top-up, top-down, top-right, top-left")->capture_default_str();
-  cmd->add_option("--tremor-deg", o->tremor_deg, "Hand tremor, RMS rotation in deg (contact default 0.057)");
+  cmd->add_option("--tremor-deg", o->tremor_deg, "Hand tremor, RMS rotation in deg (contact default 0.057)")
+      ->check(finite_within(0.0, 10.0, "deg"));
   cmd->callback([o, cmd] { run_simulate_imu(*o, *cmd); });
   add_simulate_capture_command(*simulate);
 }

@@ -1,5 +1,4 @@
 // antpose simulate capture: a simulated photo capture (board photos + IMU streams + truth).
-#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -10,6 +9,7 @@
 
 #include "antpose/sim/capture_simulator.hpp"
 #include "commands.hpp"
+#include "progress.hpp"
 
 namespace antpose::cli {
 namespace {
@@ -128,13 +128,9 @@ void run(const CaptureOptions& o) {
   if (o.radome) sc.radome = sim::parse_radome_look(*o.radome);
   sc.board_max_distance_m = o.board_max_distance_m;
   set_wide_fixes(o, distribution, sc);
-  const auto start = std::chrono::steady_clock::now();
-  sc.progress = [&](int done, int total) {
-    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    fmt::print(stderr, "\rrendering photo {}/{} ({:.1f} s)", done, total, s);
-    if (done == total) fmt::print(stderr, "\n");
-    std::fflush(stderr);
-  };
+  ProgressLine progress;
+  if (auto report = progress.callback())
+    sc.progress = [report](int done, int total) { report("rendering photos", done, total); };
   const sim::SimulatedCapture sim = sim::write_simulated_capture(sc, out, overwrite);
   std::string subject = sc.scenario == sim::Scenario::kPlanes
                             ? std::string("the room")

@@ -11,6 +11,7 @@
 #include "antpose/geomag/wmm.hpp"
 #include "antpose/io/text_file.hpp"
 #include "commands.hpp"
+#include "json_output.hpp"
 
 namespace antpose::cli {
 namespace {
@@ -43,6 +44,8 @@ void run_wmm(const WmmOptions& o) {
   const double alt_km = parse_option_number("--alt-km", o.alt_km, "km above the WGS84 ellipsoid");
   if (lat < -90.0 || lat > 90.0)
     throw InputError({}, fmt::format("--lat {}: latitude must be within [-90, 90] degrees", o.lat));
+  if (lon < -360.0 || lon > 360.0)  // one turn either way; beyond, a typing error
+    throw InputError({}, fmt::format("--lon {}: longitude must be within [-360, 360] degrees (east positive)", o.lon));
   if (alt_km < geomag::kMinAltitudeKm || alt_km > geomag::kMaxAltitudeKm)
     throw InputError({}, fmt::format("--alt-km {}: height must be within [{}, {}] km above the WGS84 ellipsoid",
                                      o.alt_km, geomag::kMinAltitudeKm, geomag::kMaxAltitudeKm));
@@ -104,7 +107,7 @@ void run_wmm(const WmmOptions& o) {
                      {"z_nT", e.z_dot_nT_per_yr}};
     j["warnings"] = nlohmann::json::array();
     for (const auto& w : diagnostics.warnings()) j["warnings"].push_back(w.to_string());
-    io::write_text_atomic(o.json, j.dump(2) + "\n");
+    write_json(o.json, j);
   }
   print_warnings(diagnostics);
 }
@@ -119,7 +122,7 @@ void add_wmm_command(CLI::App& app) {
   cmd->add_option("--alt-km", opts->alt_km, "Height above the WGS84 ellipsoid, km (default 0)");
   cmd->add_option("--date", opts->date, "Date YYYY-MM-DD (default: today, UTC)");
   cmd->add_option("--cof", opts->cof, "Coefficient file (WMM.COF) instead of the built-in WMM2025");
-  cmd->add_option("--json", opts->json, "Also write the result as JSON to this file");
+  add_json_option(cmd, opts->json, "also write the result");
   cmd->callback([opts] { run_wmm(*opts); });
 }
 

@@ -11,6 +11,19 @@
 
 namespace antpose::cli {
 
+/// Exit statuses, the contract scripts rely on (README "Exit codes"; `antpose --help`).
+enum ExitStatus : int {
+  kExitOk = 0,           // every requested result is usable
+  kExitInternal = 1,     // an internal fault (a bug to report) or the machine out of memory
+  kExitBadInput = 2,     // bad input, a command-line misuse, or an output that cannot be written
+  kExitUnsupported = 3,  // the data cannot support the measurement
+  kExitPartial = 4,      // results written, but some unusable (a failed antenna, σ over --max-sigma-deg)
+};
+inline constexpr const char* kExitStatusHelp =
+    "Exit status: 0 every requested result is usable; 2 bad input, a command-line misuse or an output that "
+    "cannot be written; 3 the data cannot support the measurement; 4 results written but some unusable "
+    "(a failed antenna, a sigma over --max-sigma-deg); 1 an internal fault.";
+
 void add_convert_command(CLI::App& app);
 void add_inspect_command(CLI::App& app);
 void add_wmm_command(CLI::App& app);
@@ -33,6 +46,9 @@ void print_warnings(const Diagnostics& diagnostics);
 /// Capture folders (holding capture.yaml) and the capture folders inside other folders, sorted by
 /// name within each; InputError for a folder that is neither.
 std::vector<std::filesystem::path> capture_folders(const std::vector<std::string>& dirs);
+
+/// A CLI11 check that a number is finite and within [lo, hi] (CLI::Range lets NaN through).
+CLI::Validator finite_within(double lo, double hi, const std::string& unit);
 
 /// The non-empty items of a comma-separated option value ("a,b,,c" → a, b, c).
 std::vector<std::string> split_list(const std::string& text);

@@ -1,6 +1,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "antpose/geomag/wmm.hpp"
@@ -89,6 +90,13 @@ TEST(WmmCli, BadArgumentsExitWithStatus2) {
   r = test::run_cli("wmm --lat 10 --lon 0 --alt-km 900");
   EXPECT_EQ(r.status, 2);
   EXPECT_THAT(r.err, HasSubstr("--alt-km 900: height must be within [-1, 850] km"));
+
+  // Finite, but no longitude: the sine of 1e16° is noise and of 1e308° NaN.
+  for (const char* lon : {"1e308", "1e16", "-361"}) {
+    r = test::run_cli(fmt::format("wmm --lat 10 --lon {}", lon));
+    EXPECT_EQ(r.status, 2) << lon;
+    EXPECT_THAT(r.err, HasSubstr(fmt::format("--lon {}: longitude must be within [-360, 360] degrees", lon)));
+  }
 }
 
 TEST(WmmCli, BadCoefficientFileNamesFileAndLine) {

@@ -195,7 +195,8 @@ TEST_P(MeasureSite, AnswersAreRightOrSayWhyNot) {
   const auto r =
       test::run_cli(fmt::format("measure '{}' --device '{}' {} --json '{}'", capture.string(),
                                 test::source_path("tests/data/phone401.yaml").string(), rois, json.string()));
-  ASSERT_TRUE(r.status == 0 || r.status == 3) << r.err << r.out;
+  // 3: no antenna measured; 4: one failed or carries a σ over --max-sigma-deg (ambiguous).
+  ASSERT_TRUE(r.status == 0 || r.status == 3 || r.status == 4) << r.err << r.out;
   const auto j = nlohmann::json::parse(io::read_text(json));
   ASSERT_EQ(j["antennas"].size(), measured.size());
   nlohmann::json rows = nlohmann::json::array();

@@ -24,6 +24,7 @@ namespace {
 namespace fs = std::filesystem;
 using ::testing::AnyOf;
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 class MeasureCli : public ::testing::Test {
  protected:
@@ -127,11 +128,25 @@ TEST_F(MeasureCli, TheBenchmarkScoresWhatMeasureAnswers) {
   }
 }
 
+TEST_F(MeasureCli, AnAntennaOverTheSigmaLimitIsWrittenAndExitsFour) {
+  const auto r = test::run_cli(measure(
+      capture(), fmt::format("--model {} --roi {} --max-sigma-deg 0.001 --json - --progress json", model_, roi_)));
+  EXPECT_EQ(r.status, 4) << r.err;
+  // Progress for a wrapper: one JSON object per line.
+  const auto first = r.err.substr(0, r.err.find('\n'));
+  EXPECT_EQ(nlohmann::json::parse(first)["stage"], "board poses") << first;
+  EXPECT_THAT(r.err, HasSubstr("warning: antenna 1 is not usable: azimuth sigma"));
+  EXPECT_THAT(r.err, HasSubstr("over --max-sigma-deg 0.001"));
+  EXPECT_FALSE(nlohmann::json::parse(r.out)["antennas"][0]["downtilt_deg"].is_null());  // written all the same
+}
+
 TEST_F(MeasureCli, TheReportShowsWhatLimitsEachSigma) {
   const auto folder = *dir_ / "report";
   const auto r = test::run_cli(
       measure(capture(), fmt::format("--model {} --roi {} --report '{}'", model_, roi_, folder.string())));
   ASSERT_EQ(r.status, 0) << r.out << r.err;
+  EXPECT_THAT(r.err, Not(HasSubstr("\r")));  // stderr is no terminal here: no progress line
+  EXPECT_THAT(r.err, Not(HasSubstr("board poses")));
   const auto html = io::read_text(folder / "index.html");
   EXPECT_THAT(html, HasSubstr("<h2>Uncertainty budget</h2>"));
   for (const char* source : {"board attitude in the world", "outline noise", "camera poses"})
@@ -200,7 +215,12 @@ TEST_F(MeasureCli, PhotosAllFromOnePlaceGiveNoConfidentNumber) {
   const auto at = lines.find(roi_image_);
   const auto start = lines.rfind('\n', at) + 1;
   const double t = std::stod(lines.substr(lines.find(',', start) + 1));
-  for (int i = 0; i < 6; ++i) shots += fmt::format("{},{},{}\n", i, t + 0.02 * i, roi_image_);
+  // Copies of the ROI's photo under other names: a photo listed twice is refused by the reader.
+  for (int i = 0; i < 6; ++i) {
+    const std::string name = i == 0 ? roi_image_ : fmt::format("images/again_{}.jpg", i);
+    if (i > 0) fs::copy_file(cap / roi_image_, cap / name);
+    shots += fmt::format("{},{},{}\n", i, t + 0.02 * i, name);
+  }
   test::write_file(cap / "shots.csv", shots);
   const auto json = *dir_ / "one-place.json";
   const auto r =

@@ -20,10 +20,12 @@ const std::string kSmall = " --scenario camera-calibration --photos 3 --width 16
 TEST(SimulateCaptureCli, WritesCaptureAndRefusesToOverwrite) {
   test::TempDir dir;
   const std::string out = (dir / "cc").string();
-  const auto r = test::run_cli("simulate capture -o '" + out + "'" + kSmall + " --seed 4 --time-offset-ms 25 --board charuco");
+  const auto r = test::run_cli("simulate capture -o '" + out + "'" + kSmall +
+                               " --seed 4 --time-offset-ms 25 --board charuco --progress json");
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_THAT(r.out, HasSubstr("3 photos 160x120"));
-  EXPECT_THAT(r.err, HasSubstr("rendering photo 3/3"));
+  EXPECT_THAT(r.err, HasSubstr("\"done\":3,"));
+  EXPECT_THAT(r.err, HasSubstr("\"stage\":\"rendering photos\""));
   Diagnostics diag;
   const Capture c = read_capture(out, diag);
   EXPECT_EQ(c.kind, "camera-calibration");

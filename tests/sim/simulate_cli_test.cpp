@@ -96,7 +96,15 @@ TEST(SimulateCli, BadOptionsNameTheOptionAndTheValue) {
   EXPECT_THAT(r.err, HasSubstr("--duration: 3 s is too short for the contact preset"));
   r = test::run_cli("simulate imu" + out + " --preset contact --antenna-downtilt-deg 95");
   EXPECT_EQ(r.status, 2);
-  EXPECT_THAT(r.err, HasSubstr("--antenna-downtilt-deg: 95 is out of range"));
+  EXPECT_THAT(r.err, HasSubstr("--antenna-downtilt-deg: 95 must be within [-90, 90] deg"));
+  // Values that once gave streams of NaN.
+  r = test::run_cli("simulate imu" + out + " --preset contact --tremor-deg nan");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_THAT(r.err, HasSubstr("--tremor-deg: nan must be within [0, 10] deg"));
+  r = test::run_cli("simulate imu" + out + " --preset contact --antenna-azimuth-deg 1e308");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_THAT(r.err, HasSubstr("--antenna-azimuth-deg: 1e308 must be within [-360, 360] deg"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "x"));
   r = test::run_cli("simulate imu" + out + " --preset contact --placement sideways");
   EXPECT_EQ(r.status, 2);
   EXPECT_THAT(r.err, HasSubstr("--placement"));

@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include <cstdlib>
+#include <fstream>
 #include <optional>
 #include <random>
 
@@ -26,6 +27,53 @@ imu:
 camera: {width_px: 640, height_px: 480, fx_px: 500, fy_px: 500, cx_px: 320, cy_px: 240, note: kept}
 )";
 
+TEST(DeviceCli, AFolderWithoutWritePermissionIsReadButNotWritten) {
+  test::TempDir dir;
+  const fs::path db = dir / "shared" / "d.sqlite";
+  test::write_file(dir / "p.yaml", kProfile);
+  ASSERT_EQ(test::run_cli(fmt::format("device import {} --db {}", (dir / "p.yaml").string(), db.string())).status, 0);
+  // Root may write anywhere: the commands then run as nobody, for whom the folder is read-only.
+  fs::permissions(dir.path(), fs::perms::owner_all | fs::perms::group_read | fs::perms::group_exec |
+                                  fs::perms::others_read | fs::perms::others_exec);
+  fs::permissions(db.parent_path(), fs::perms::owner_read | fs::perms::owner_exec | fs::perms::group_read |
+                                        fs::perms::group_exec | fs::perms::others_read | fs::perms::others_exec);
+  const auto run = [](const std::string& args) { return test::run_cli_unprivileged(args); };
+  auto r = run("device list --db " + db.string());
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("px7"));
+  r = run("device show px7 --db " + db.string());
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("fx_px: 500"));
+  r = run(fmt::format("device import {} --id other --db {}", (dir / "p.yaml").string(), db.string()));
+  EXPECT_EQ(r.status, 2);
+  EXPECT_THAT(r.err, HasSubstr("d.sqlite: "));
+  fs::permissions(db.parent_path(), fs::perms::owner_all);
+}
+
+TEST(DeviceCli, ADamagedDatabaseTakesNoWrites) {
+  test::TempDir dir;
+  const fs::path db = dir / "d.sqlite";
+  test::write_file(dir / "p.yaml", kProfile);
+  for (int i = 0; i < 40; ++i)
+    ASSERT_EQ(
+        test::run_cli(fmt::format("device import {} --id dev{:02d} --db {}", (dir / "p.yaml").string(), i, db.string()))
+            .status,
+        0);
+  {
+    std::fstream f(db, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(4096 + 100);
+    const std::string garbage(8192, '\x5a');
+    f.write(garbage.data(), static_cast<std::streamsize>(garbage.size()));
+  }
+  const auto before = fs::file_size(db);
+  const auto r =
+      test::run_cli(fmt::format("device import {} --id late --db {}", (dir / "p.yaml").string(), db.string()));
+  EXPECT_EQ(r.status, 2);
+  EXPECT_THAT(r.err, HasSubstr("the device database is corrupt"));
+  EXPECT_THAT(r.err, HasSubstr("nothing was written into it"));
+  EXPECT_EQ(fs::file_size(db), before);
+}
+
 TEST(DeviceCli, ImportListShowExportRemove) {
   test::TempDir dir;
   const std::string db = "--db " + (dir / "d.sqlite").string();
@@ -46,7 +94,7 @@ TEST(DeviceCli, ImportListShowExportRemove) {
   EXPECT_EQ(r.status, 0) << r.err;
   EXPECT_THAT(r.out, HasSubstr("note: kept"));
   EXPECT_THAT(r.out, HasSubstr("import      ok"));
-  r = test::run_cli("device show px7 --history --json " + db);
+  r = test::run_cli("device show px7 --history --json - " + db);
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["id"], "px7");
   ASSERT_EQ(j["history"].size(), 1u);
