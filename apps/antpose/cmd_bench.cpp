@@ -22,6 +22,7 @@
 #include "antpose/io/text_file.hpp"
 #include "antpose/orientation/orientation_benchmark.hpp"
 #include "antpose/orientation/rest_benchmark.hpp"
+#include "cli_provenance.hpp"
 #include "commands.hpp"
 #include "json_output.hpp"
 
@@ -119,7 +120,7 @@ nlohmann::json score_json(const orientation::TrackScore& s) {
           {"roll_mae_deg", rad2deg(s.roll_mae)}};
 }
 
-void run_orientation_bench(const OrientationBenchArgs& args) {
+void run_orientation_bench(const OrientationBenchArgs& args, const CLI::App& verb) {
   Diagnostics diagnostics;
   const std::vector<std::string> methods =
       args.methods.empty() ? orientation::estimator_names() : split_list(args.methods);
@@ -179,7 +180,9 @@ void run_orientation_bench(const OrientationBenchArgs& args) {
                                 {"methods", methods},
                                 {"trials", jt},
                                 {"means", means}};
-    write_json(args.json, out);
+    store::Provenance provenance = provenance_of(verb);
+    for (const auto& folder : capture_folders(args.dirs)) provenance.input("capture", folder);
+    write_json(args.json, out, provenance);
     if (args.json != "-") fmt::print("\nJSON written to {}\n", args.json);
   }
   print_warnings(diagnostics);
@@ -239,15 +242,21 @@ struct RegistrationBenchArgs {
 };
 
 // The comparison links PCL and Open3D, which antpose itself never does (benchmark-only
-// dependencies, not in CI), so it is a program of its own, built beside antpose where
-// scripts/install-bench-deps.sh installed them; this verb runs it in this process' place.
+// dependencies, not in CI), so it is a program of its own, built into the folder of the antpose
+// executable where scripts/install-bench-deps.sh installed them; this verb runs it in this
+// process' place. Found beside the running executable, never at a path fixed when building.
 [[noreturn]] void run_registration_bench(const RegistrationBenchArgs& args) {
   if (!args.shared.empty() && !fs::exists(fs::path(args.shared) / "data/pointclouds/pcl/bun0.ply"))
     throw InputError(args.shared, "no data/pointclouds/pcl/bun0.ply (expected the shared data folder)");
-#ifdef ANTPOSE_BENCH_REGISTRATION
-  const std::string program = ANTPOSE_BENCH_REGISTRATION;
-  if (!fs::exists(program))
-    throw Error(fmt::format("{} is not built yet: cmake --build build --target antpose_bench_registration", program));
+  std::error_code ec;
+  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
+  const std::string program = (self.parent_path() / "antpose_bench_registration").string();
+  if (ec || !fs::is_regular_file(program))
+    throw InputError(
+        {}, fmt::format("no registration comparison beside this antpose ({}): it needs PCL and Open3D (benchmark-only "
+                        "dependencies: scripts/install-bench-deps.sh), then cmake --build build --target "
+                        "antpose_bench_registration",
+                        program));
   std::vector<std::string> words{program, "--repeats", std::to_string(args.repeats)};
   if (!args.json.empty()) words.insert(words.end(), {"--json", args.json});
   if (!args.shared.empty()) words.push_back(args.shared);
@@ -257,12 +266,6 @@ struct RegistrationBenchArgs {
   std::fflush(nullptr);
   execv(program.c_str(), argv.data());
   throw Error(fmt::format("{}: cannot run it: {}", program, std::strerror(errno)));
-#else
-  throw Error(
-      "this build has no registration comparison: it needs PCL and Open3D (benchmark-only dependencies: "
-      "scripts/install-bench-deps.sh) and the benchmarks built (ANTPOSE_BUILD_BENCH=ON, the default); then "
-      "run scripts/setup.sh");
-#endif
 }
 
 }  // namespace
@@ -289,7 +292,7 @@ void add_bench_command(CLI::App& app) {
                                       "WMM2025, the model valid for the capture date is used, else the nearest epoch)");
   ob->add_option("--skip-s", oargs->skip_s, "truth without a moving column: seconds left out at its start")
       ->capture_default_str();
-  ob->callback([oargs] { run_orientation_bench(*oargs); });
+  ob->callback([oargs, ob] { run_orientation_bench(*oargs, *ob); });
 
   auto gargs = std::make_shared<OrientationBenchArgs>();
   auto* og = bench->add_subcommand("orientation-grid",

@@ -19,6 +19,7 @@
 #include "antpose/measure/device_setup.hpp"
 #include "antpose/measure/site_benchmark.hpp"
 #include "antpose/store/device_ref.hpp"
+#include "cli_provenance.hpp"
 #include "commands.hpp"
 #include "json_output.hpp"
 #include "progress.hpp"
@@ -55,7 +56,7 @@ void print_site(const measure::SiteBenchmark& s) {
   }
 }
 
-void run_measure_bench(const MeasureBenchArgs& args) {
+void run_measure_bench(const MeasureBenchArgs& args, const CLI::App& verb) {
   const auto ref = store::resolve_device_ref(args.device, args.db ? std::optional<fs::path>(*args.db) : std::nullopt);
   const fs::path where = ref.file ? *ref.file : fs::path("--device " + ref.profile.id);
   const auto setup = measure::device_setup(ref.profile, where);
@@ -80,7 +81,12 @@ void run_measure_bench(const MeasureBenchArgs& args) {
   if (!seconds.empty())
     fmt::print("{} sites: median {:.1f} s, slowest {:.1f} s per site\n", seconds.size(), seconds[seconds.size() / 2],
                seconds.back());
-  write_json(args.json, nlohmann::json{{"sites", sites}});
+  if (!args.json.empty()) {
+    store::Provenance provenance = provenance_of(verb);
+    add_device(provenance, ref);
+    for (const auto& folder : folders) provenance.input("capture", folder);
+    write_json(args.json, nlohmann::json{{"sites", sites}}, provenance);
+  }
 }
 
 }  // namespace
@@ -94,7 +100,7 @@ void add_bench_measure_command(CLI::App& bench) {
       ->required();
   cmd->add_option("--db", args->db, "device database (default as 'antpose device')");
   add_json_option(cmd, args->json, "write the per-site results");
-  cmd->callback([args] { run_measure_bench(*args); });
+  cmd->callback([args, cmd] { run_measure_bench(*args, *cmd); });
 }
 
 }  // namespace antpose::cli

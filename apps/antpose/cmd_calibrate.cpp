@@ -12,6 +12,7 @@
 #include "antpose/calibration/allan.hpp"
 #include "antpose/calibration/calibrate_imu.hpp"
 #include "antpose/io/text_file.hpp"
+#include "cli_provenance.hpp"
 #include "commands.hpp"
 #include "json_output.hpp"
 #include "device_calibration.hpp"
@@ -98,7 +99,7 @@ struct AllanArgs {
   int per_decade = 10;
 };
 
-void run_allan(const AllanArgs& args) {
+void run_allan(const AllanArgs& args, const CLI::App& verb) {
   Diagnostics diagnostics;
   const Capture capture = read_capture(args.capture, diagnostics);
   const Stream& stream = capture.require(args.stream);
@@ -132,7 +133,7 @@ void run_allan(const AllanArgs& args) {
     j["axes"].push_back(axis);
     series.push_back({args.stream + " " + a.axes[k], a.curves[k], f});
   }
-  write_json(args.json, j);
+  if (!args.json.empty()) write_json(args.json, j, provenance_of(verb).input("capture", args.capture));
   if (!args.plot.empty())
     io::write_text_atomic(args.plot,
                           calibration::allan_svg(series, "Overlapping Allan deviation: " + args.capture, unit));
@@ -171,7 +172,7 @@ void add_calibrate_command(CLI::App& app) {
   add_json_option(allan, allan_args->json, "write the curves and fits");
   allan->add_option("--plot", allan_args->plot, "write a log-log SVG plot");
   allan->add_option("--per-decade", allan_args->per_decade, "averaging times per decade")->capture_default_str();
-  allan->callback([allan_args] { run_allan(*allan_args); });
+  allan->callback([allan_args, allan] { run_allan(*allan_args, *allan); });
 }
 
 }  // namespace antpose::cli

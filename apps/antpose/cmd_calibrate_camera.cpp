@@ -11,6 +11,7 @@
 
 #include "antpose/camera/calibrate_camera.hpp"
 #include "antpose/io/text_file.hpp"
+#include "cli_provenance.hpp"
 #include "commands.hpp"
 #include "json_output.hpp"
 #include "device_calibration.hpp"
@@ -57,7 +58,7 @@ nlohmann::json to_json(const camera::CameraCalibrationResult& r) {
   return j;
 }
 
-void run_camera(const CameraArgs& args) {
+void run_camera(const CameraArgs& args, const CLI::App& verb) {
   Diagnostics diagnostics;
   camera::CalibrationSettings settings;
   if (!args.config.empty()) settings = camera::read_calibration_settings(args.config, diagnostics);
@@ -95,7 +96,12 @@ void run_camera(const CameraArgs& args) {
       camera::write_camera_file(args.output, result, args.force);
       fmt::print("wrote {}\n", args.output);
     }
-    write_json(args.json, to_json(result));
+    if (!args.json.empty()) {
+      store::Provenance provenance = provenance_of(verb).input("capture", args.capture);
+      if (!args.config.empty()) provenance.input("config", args.config);
+      if (device) add_device(provenance, *device);
+      write_json(args.json, to_json(result), provenance);
+    }
     CalibrationOutcome outcome;
     outcome.residuals = {{"rms_px", result.rms_px},
                          {"photos_used", result.used_count()},
@@ -131,7 +137,7 @@ void add_calibrate_camera_command(CLI::App& calibrate) {
   args->device.add_to(*cmd);
   cmd->add_flag("--force", args->force, "replace an existing output file");
   add_json_option(cmd, args->json, "also write the result");
-  cmd->callback([args] { run_camera(*args); });
+  cmd->callback([args, cmd] { run_camera(*args, *cmd); });
 }
 
 }  // namespace antpose::cli

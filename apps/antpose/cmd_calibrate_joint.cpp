@@ -20,6 +20,7 @@
 #include "antpose/io/report_text.hpp"
 #include "antpose/io/text_file.hpp"
 #include "antpose/orientation/estimator.hpp"
+#include "cli_provenance.hpp"
 #include "commands.hpp"
 #include "json_output.hpp"
 #include "progress.hpp"
@@ -69,7 +70,8 @@ store::CameraCalibrationInfo joint_intrinsics(const JointArgs& args, const std::
       "(antpose calibrate camera --device)");
 }
 
-CalibrationOutcome joint_calibration(const JointArgs& args, const std::optional<store::DeviceRef>& device,
+CalibrationOutcome joint_calibration(const JointArgs& args, const CLI::App& verb,
+                                     const std::optional<store::DeviceRef>& device,
                                      const std::vector<std::string>& methods, Diagnostics& diagnostics) {
   Capture capture = read_capture(args.capture, diagnostics);
   const bool imu_calibrated = device && device->profile.has_imu;
@@ -226,13 +228,19 @@ CalibrationOutcome joint_calibration(const JointArgs& args, const std::optional<
                            {"azimuth_error_deg", r.optimised.overall.azimuth_error_deg}};
     }
   }
-  write_json(args.json, j);
+  if (!args.json.empty()) {
+    store::Provenance provenance = provenance_of(verb).input("capture", args.capture);
+    if (!args.camera.empty()) provenance.input("camera", args.camera);
+    if (device) add_device(provenance, *device);
+    provenance.site = capture.site;
+    write_json(args.json, j, provenance);
+  }
   if (!stored) throw MeasurementError("camera–IMU calibration: no method produced a result");
   outcome.apply = [c = *stored](store::DeviceProfile& current) { current.camera_imu = c; };
   return outcome;
 }
 
-void run_joint(const JointArgs& args) {
+void run_joint(const JointArgs& args, const CLI::App& verb) {
   if (args.method != "reference-free" && args.method != "thesis" && args.method != "both")
     throw InputError("--method",
                      fmt::format("'{}' is not a method, expected reference-free, thesis or both", args.method));
@@ -250,7 +258,7 @@ void run_joint(const JointArgs& args) {
   std::vector<fs::path> inputs{args.capture};
   if (!args.camera.empty()) inputs.emplace_back(args.camera);
   run_calibration(device, "camera-imu", settings, inputs, diagnostics,
-                  [&] { return joint_calibration(args, device, methods, diagnostics); });
+                  [&] { return joint_calibration(args, verb, device, methods, diagnostics); });
 }
 
 }  // namespace
@@ -280,7 +288,7 @@ void add_calibrate_joint_command(CLI::App& calibrate) {
       ->check(finite_within(defaults.time_offset_min_s, defaults.time_offset_max_s, "s"));
   cmd->add_flag("--fixed-time-offset", args->fixed_time_offset, "do not estimate the time offset");
   add_json_option(cmd, args->json, "also write the result");
-  cmd->callback([args] { run_joint(*args); });
+  cmd->callback([args, cmd] { run_joint(*args, *cmd); });
 }
 
 }  // namespace antpose::cli

@@ -9,6 +9,7 @@
 #include "antpose/imu/imu_calibration.hpp"
 #include "antpose/io/text_file.hpp"
 #include "antpose/measure/contact.hpp"
+#include "cli_provenance.hpp"
 #include "commands.hpp"
 #include "json_output.hpp"
 #include "usable.hpp"
@@ -58,7 +59,7 @@ std::vector<AngleReading> readings(const measure::ContactResult& r) {
           {"roll", r.roll, r.sigma.roll}};
 }
 
-int run_contact(const ContactArgs& args) {
+int run_contact(const ContactArgs& args, const CLI::App& verb) {
   measure::ContactOptions options;
   try {
     options.placement = parse_contact_placement(args.placement);
@@ -102,7 +103,12 @@ int run_contact(const ContactArgs& args) {
   for (const auto& w : r.warnings) result_warnings.warn(w);
   print_warnings(result_warnings);
 
-  write_json(args.json, measure::to_json(r));
+  if (!args.json.empty()) {
+    store::Provenance provenance = provenance_of(verb).input("capture", args.capture);
+    if (!args.calibration.empty()) provenance.input("IMU calibration", args.calibration);
+    provenance.site = capture.site;
+    write_json(args.json, measure::to_json(r), provenance);
+  }
   if (const std::string why = unusable_reason(readings(r), args.max_sigma_deg); !why.empty()) {
     fmt::print(stderr, "warning: the result is not usable: {}\n", why);
     return kExitPartial;
@@ -124,8 +130,8 @@ void add_contact_command(CLI::App& app) {
   add_json_option(cmd, args->json, "write the result");
   add_max_sigma_option(cmd, args->max_sigma_deg);
   cmd->add_flag("--no-unit-repair", args->no_unit_repair, "treat streams in the wrong unit as errors");
-  cmd->callback([args] {
-    if (const int status = run_contact(*args); status != kExitOk) throw CLI::RuntimeError(status);
+  cmd->callback([args, cmd] {
+    if (const int status = run_contact(*args, *cmd); status != kExitOk) throw CLI::RuntimeError(status);
   });
 }
 

@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "antpose/store/device_db.hpp"
+#include "cli_provenance.hpp"
 #include "commands.hpp"
 #include "json_output.hpp"
 
@@ -57,7 +58,7 @@ nlohmann::json run_json(const store::CalibrationRun& r) {
           {"profile_yaml", r.profile_yaml}};
 }
 
-void run_show(const DeviceArgs& a) {
+void run_show(const DeviceArgs& a, const CLI::App& verb) {
   const store::DeviceDb db = open_db(a, store::DeviceDb::Access::kReadOnly);
   const store::DeviceProfile profile = db.profile(a.id);
   const std::string yaml = store::format_device_profile(profile);
@@ -67,7 +68,10 @@ void run_show(const DeviceArgs& a) {
       j["history"] = nlohmann::json::array();
       for (const auto& r : db.history(a.id)) j["history"].push_back(run_json(r));
     }
-    write_json(a.json, j);
+    store::Provenance provenance = provenance_of(verb).input("device database", db.path());
+    provenance.device_id = profile.id;
+    provenance.device_profile_sha256 = store::sha256_bytes(yaml);
+    write_json(a.json, j, provenance);
     return;
   }
   fmt::print("{}", yaml);
@@ -118,7 +122,7 @@ void add_device_command(CLI::App& app) {
   show->add_flag("--history", a->history, "also list the calibration runs");
   add_json_option(show, a->json, "write the profile (and --history) instead of printing YAML");
   add_db_option(show, *a);
-  show->callback([a] { run_show(*a); });
+  show->callback([a, show] { run_show(*a, *show); });
 
   auto* exp = cmd->add_subcommand("export", "write the current profile of a device as a YAML file");
   exp->add_option("id", a->id, "device id")->required();

@@ -7,6 +7,7 @@
 #include "antpose/io/import.hpp"
 #include "antpose/io/inspect.hpp"
 #include "antpose/io/text_file.hpp"
+#include "cli_provenance.hpp"
 #include "commands.hpp"
 #include "json_output.hpp"
 
@@ -20,7 +21,7 @@ struct InspectOptions {
   bool no_unit_repair = false;
 };
 
-void run_inspect(const InspectOptions& o) {
+void run_inspect(const InspectOptions& o, const CLI::App& verb) {
   Diagnostics diagnostics;
   CaptureReadOptions read_options;
   read_options.repair_units = !o.no_unit_repair;
@@ -30,7 +31,11 @@ void run_inspect(const InspectOptions& o) {
   summary.format = std::string(to_string(format));
   print_warnings(diagnostics);
   fmt::print("{}", format_summary(summary));
-  write_json(o.json, to_json(summary));
+  if (!o.json.empty()) {
+    store::Provenance provenance = provenance_of(verb).input("capture", o.capture);
+    provenance.site = capture.site;
+    write_json(o.json, to_json(summary), provenance);
+  }
 }
 
 }  // namespace
@@ -41,7 +46,7 @@ void add_inspect_command(CLI::App& app) {
   cmd->add_option("CAPTURE", opts->capture, "Capture folder or export (any layout convert reads)")->required();
   add_json_option(cmd, opts->json, "also write the summary");
   cmd->add_flag("--no-unit-repair", opts->no_unit_repair, "Refuse streams in the wrong unit instead of converting them");
-  cmd->callback([opts] { run_inspect(*opts); });
+  cmd->callback([opts, cmd] { run_inspect(*opts, *cmd); });
 }
 
 }  // namespace antpose::cli

@@ -20,6 +20,7 @@
 #include "antpose/model/antenna_model.hpp"
 #include "antpose/orientation/estimator.hpp"
 #include "antpose/store/device_ref.hpp"
+#include "cli_provenance.hpp"
 #include "commands.hpp"
 #include "json_output.hpp"
 #include "progress.hpp"
@@ -133,7 +134,20 @@ int exit_status(const measure::NonContactResult& r, double max_sigma_deg) {
   return failed + unusable > 0 ? kExitPartial : kExitOk;
 }
 
-int run_measure(const MeasureArgs& a) {
+// The capture, the device, and the mesh and box files among the models (a built-in panel is in
+// the options by name).
+store::Provenance measure_provenance(const MeasureArgs& a, const CLI::App& verb, const store::DeviceRef& device,
+                                     const Capture& capture) {
+  store::Provenance p = provenance_of(verb).input("capture", a.capture);
+  add_device(p, device);
+  for (const auto& files : {a.models, a.model_boxes})
+    for (const auto& file : files)
+      if (fs::is_regular_file(file)) p.input("model", file);
+  p.site = capture.site;
+  return p;
+}
+
+int run_measure(const MeasureArgs& a, const CLI::App& verb) {
   if (a.rois.empty())
     throw InputError("--roi", "at least one --roi IMAGE:x,y,w,h is needed (the antenna in one photo)");
   const auto ref = store::resolve_device_ref(a.device, a.db ? std::optional<fs::path>(*a.db) : std::nullopt);
@@ -170,10 +184,13 @@ int run_measure(const MeasureArgs& a) {
     for (const auto& w : m.warnings) result_warnings.warn(fmt::format("antenna {}: {}", k + 1, w));
   }
   print_warnings(result_warnings);
-  write_json(a.json, measure::to_json(result));
-  if (!a.report.empty()) {
-    measure::write_report(a.report, capture, setup, result, a.force);
-    fmt::print("report: {}\n", (fs::path(a.report) / "index.html").string());
+  if (!a.json.empty() || !a.report.empty()) {  // hashing the photos costs a moment: only when kept
+    const store::Provenance provenance = measure_provenance(a, verb, ref, capture);
+    write_json(a.json, measure::to_json(result), provenance);
+    if (!a.report.empty()) {
+      measure::write_report(a.report, capture, setup, result, provenance, a.force);
+      fmt::print("report: {}\n", (fs::path(a.report) / "index.html").string());
+    }
   }
   return exit_status(result, a.max_sigma_deg);
 }
@@ -205,8 +222,8 @@ void add_measure_command(CLI::App& app) {
   cmd->add_option("--report", a->report, "write a report folder (HTML, overlays, PLY clouds)");
   cmd->add_flag("--force", a->force, "replace an existing report folder");
   add_max_sigma_option(cmd, a->max_sigma_deg);
-  cmd->callback([a] {
-    const int status = run_measure(*a);
+  cmd->callback([a, cmd] {
+    const int status = run_measure(*a, *cmd);
     if (status != 0) throw CLI::RuntimeError(status);
   });
 }

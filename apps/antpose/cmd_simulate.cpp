@@ -11,6 +11,7 @@
 #include "antpose/geomag/wmm.hpp"
 #include "antpose/io/capture.hpp"
 #include "antpose/sim/imu_simulator.hpp"
+#include "antpose/geomag/earth_model.hpp"
 #include "commands.hpp"
 
 namespace antpose::cli {
@@ -89,7 +90,7 @@ void run_simulate_imu(const SimulateOptions& o, const CLI::App& cmd) {
     }
     if (field.validity_warning) fmt::print(stderr, "warning: {}\n", *field.validity_warning);
     s.field_world_uT = field.field_enu_uT;
-    s.gravity = sim::normal_gravity(site.lat_deg, site.alt_m);
+    s.gravity = geomag::normal_gravity(site.lat_deg, site.alt_m);
     s.time_origin = site.date + "T12:00:00Z";
     s.site = site;
   } else if (!o.date.empty() || cmd.count("--alt-m") > 0) {

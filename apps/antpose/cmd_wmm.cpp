@@ -10,6 +10,7 @@
 
 #include "antpose/geomag/wmm.hpp"
 #include "antpose/io/text_file.hpp"
+#include "cli_provenance.hpp"
 #include "commands.hpp"
 #include "json_output.hpp"
 
@@ -38,7 +39,7 @@ double parse_option_number(const std::string& option, const std::string& text, c
 
 nlohmann::json optional_json(const std::optional<double>& v) { return v ? nlohmann::json(*v) : nlohmann::json(); }
 
-void run_wmm(const WmmOptions& o) {
+void run_wmm(const WmmOptions& o, const CLI::App& verb) {
   const double lat = parse_option_number("--lat", o.lat, "degrees in [-90, 90], north positive");
   const double lon = parse_option_number("--lon", o.lon, "degrees, east positive");
   const double alt_km = parse_option_number("--alt-km", o.alt_km, "km above the WGS84 ellipsoid");
@@ -107,7 +108,9 @@ void run_wmm(const WmmOptions& o) {
                      {"z_nT", e.z_dot_nT_per_yr}};
     j["warnings"] = nlohmann::json::array();
     for (const auto& w : diagnostics.warnings()) j["warnings"].push_back(w.to_string());
-    write_json(o.json, j);
+    store::Provenance provenance = provenance_of(verb);
+    if (!o.cof.empty()) provenance.input("coefficients", o.cof);
+    write_json(o.json, j, provenance);
   }
   print_warnings(diagnostics);
 }
@@ -123,7 +126,7 @@ void add_wmm_command(CLI::App& app) {
   cmd->add_option("--date", opts->date, "Date YYYY-MM-DD (default: today, UTC)");
   cmd->add_option("--cof", opts->cof, "Coefficient file (WMM.COF) instead of the built-in WMM2025");
   add_json_option(cmd, opts->json, "also write the result");
-  cmd->callback([opts] { run_wmm(*opts); });
+  cmd->callback([opts, cmd] { run_wmm(*opts, *cmd); });
 }
 
 }  // namespace antpose::cli

@@ -30,8 +30,9 @@ CLI::Option* add_json_option(CLI::App* cmd, std::string& target, const std::stri
       });
 }
 
-void write_json(const std::string& target, const nlohmann::json& j) {
+void write_json(const std::string& target, nlohmann::json j, const store::Provenance& provenance) {
   if (target.empty()) return;
+  j["provenance"] = store::to_json(provenance);
   const std::string text = j.dump(2) + "\n";
   if (target == "-")
     io::write_descriptor(json_descriptor, text, "-");

@@ -13,6 +13,7 @@
 #include <fmt/core.h>
 
 #include "antpose/core/allocator.hpp"
+#include "antpose/version.hpp"
 #include "commands.hpp"
 #include "progress.hpp"
 
@@ -95,7 +96,7 @@ int main(int argc, char** argv) {
   antpose::tune_allocator();  // before any work: see core/allocator.hpp
   CLI::App app{"antpose: antenna azimuth, downtilt and roll from a smartphone"};
   app.require_subcommand(1);
-  app.set_version_flag("--version", "antpose 0.1.0");
+  app.set_version_flag("--version", "antpose " + antpose::version_string());
   app.footer(kExitStatusHelp);
   app.fallthrough();  // the global options (--quiet, --progress) may follow the verb
   add_progress_options(app);

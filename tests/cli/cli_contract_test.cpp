@@ -161,7 +161,11 @@ TEST(CliContract, AResultOverTheSigmaLimitIsWrittenAndExitsFour) {
   EXPECT_EQ(r.status, 4) << r.err;
   EXPECT_THAT(r.err, HasSubstr("warning: the result is not usable: azimuth sigma"));
   EXPECT_THAT(r.err, HasSubstr("over --max-sigma-deg 0.01"));
-  EXPECT_TRUE(nlohmann::json::parse(io::read_text(json)).contains("downtilt_deg"));
+  const auto j = nlohmann::json::parse(io::read_text(json));
+  EXPECT_TRUE(j.contains("downtilt_deg"));
+  EXPECT_EQ(j["provenance"]["command"], "contact");
+  EXPECT_EQ(j["provenance"]["inputs"][0]["role"], "capture");
+  EXPECT_EQ(j["provenance"]["options"]["--max-sigma-deg"], "0.01");
   r = test::run_cli(fmt::format("contact '{}' --max-sigma-deg -1", cap.string()));
   EXPECT_EQ(r.status, 2);
 }

@@ -16,6 +16,8 @@
 
 #include "antpose/io/text_file.hpp"
 #include "antpose/model/antenna_model.hpp"
+#include "antpose/store/content_hash.hpp"
+#include "antpose/version.hpp"
 #include "support/test_support.hpp"
 
 namespace antpose {
@@ -137,7 +139,17 @@ TEST_F(MeasureCli, AnAntennaOverTheSigmaLimitIsWrittenAndExitsFour) {
   EXPECT_EQ(nlohmann::json::parse(first)["stage"], "board poses") << first;
   EXPECT_THAT(r.err, HasSubstr("warning: antenna 1 is not usable: azimuth sigma"));
   EXPECT_THAT(r.err, HasSubstr("over --max-sigma-deg 0.001"));
-  EXPECT_FALSE(nlohmann::json::parse(r.out)["antennas"][0]["downtilt_deg"].is_null());  // written all the same
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_FALSE(j["antennas"][0]["downtilt_deg"].is_null());  // written all the same
+  // What produced it: this antpose, the capture and the device by content, the options given.
+  const auto& p = j["provenance"];
+  EXPECT_EQ(p["command"], "measure");
+  EXPECT_THAT(p["antpose"].get<std::string>(), HasSubstr(std::string(kVersion)));
+  EXPECT_EQ(p["inputs"][0]["role"], "capture");
+  EXPECT_EQ(p["inputs"][0]["sha256"], store::content_digest(capture()));
+  EXPECT_EQ(p["device"]["profile_sha256"].get<std::string>().size(), 64u);
+  EXPECT_EQ(p["options"]["--max-sigma-deg"], "0.001");
+  EXPECT_FALSE(p["site"].is_null());
 }
 
 TEST_F(MeasureCli, TheReportShowsWhatLimitsEachSigma) {
@@ -149,6 +161,8 @@ TEST_F(MeasureCli, TheReportShowsWhatLimitsEachSigma) {
   EXPECT_THAT(r.err, Not(HasSubstr("board poses")));
   const auto html = io::read_text(folder / "index.html");
   EXPECT_THAT(html, HasSubstr("<h2>Uncertainty budget</h2>"));
+  EXPECT_THAT(html, HasSubstr("<h2>Provenance</h2>"));
+  EXPECT_TRUE(nlohmann::json::parse(io::read_text(folder / "result.json")).contains("provenance"));
   for (const char* source : {"board attitude in the world", "outline noise", "camera poses"})
     EXPECT_THAT(html, HasSubstr(fmt::format("<td>{}</td>", source)));
 }

@@ -6,7 +6,7 @@
 #include <fmt/format.h>
 
 #include "antpose/io/text_file.hpp"
-#include "antpose/sim/imu_simulator.hpp"
+#include "antpose/geomag/earth_model.hpp"
 
 namespace antpose::calibration {
 namespace fs = std::filesystem;
@@ -40,8 +40,8 @@ CalibrateImuResult calibrate_imu(const Capture& capture, const CalibrateImuOptio
   r.calibration = base;
   if (r.calibration.device_model.empty()) r.calibration.device_model = capture.device_model;
   if (r.calibration.device_id.empty()) r.calibration.device_id = capture.device_id;
-  r.gravity = o.gravity ? *o.gravity
-              : capture.site ? sim::normal_gravity(capture.site->lat_deg, capture.site->alt_m)
+  r.gravity = o.gravity      ? *o.gravity
+              : capture.site ? geomag::normal_gravity(capture.site->lat_deg, capture.site->alt_m)
                              : 9.80665;
   const std::string src = source.string();
   auto& cal = r.calibration;

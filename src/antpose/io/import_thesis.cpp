@@ -13,6 +13,7 @@
 
 #include "antpose/io/csv.hpp"
 #include "antpose/io/import.hpp"
+#include "antpose/io/file_access.hpp"
 #include "antpose/io/import_detail.hpp"
 #include "antpose/io/text_file.hpp"
 #include "antpose/io/time.hpp"
@@ -151,11 +152,11 @@ Capture import_thesis_project(const fs::path& in, Diagnostics& diagnostics, cons
     col.utc = required_number(proj, node, "time", "shot time in UTC seconds since 1970");
     if (auto pic = child_ci(node, "picture"); pic && !trimmed_text(pic).empty()) {
       col.picture = trimmed_text(pic);
-      if (!fs::is_regular_file(folder / col.picture))
+      if (!fs::is_regular_file(io::path_inside(folder, col.picture, {proj_file, proj.line(pic), "picture"})))
         throw InputError(proj_file, proj.line(pic), fmt::format("picture '{}' not found in {}", col.picture, folder.string()));
     }
     if (auto sen = child_ci(node, "sensor"); sen && !trimmed_text(sen).empty()) {
-      const fs::path f = folder / trimmed_text(sen);
+      const fs::path f = io::path_inside(folder, trimmed_text(sen), {proj_file, proj.line(sen), "sensor"});
       if (!fs::is_regular_file(f))
         throw InputError(proj_file, proj.line(sen), fmt::format("sensor file '{}' not found in {}", trimmed_text(sen), folder.string()));
       if (std::find(sensor_files.begin(), sensor_files.end(), f) == sensor_files.end()) sensor_files.push_back(f);

@@ -162,7 +162,26 @@ std::string residual_svg(const BoardWorldAttitude& board) {
   return svg + "</svg>";
 }
 
-std::string html_page(const Capture& capture, const NonContactResult& r, const std::vector<std::string>& overlays) {
+// What produced the report: antpose, the inputs by content, the device, the options.
+std::string provenance_table(const store::Provenance& p) {
+  std::string h = "<h2>Provenance</h2><table>";
+  const auto row = [&](const std::string& key, const std::string& value) {
+    h += fmt::format("<tr><th>{}</th><td style=\"text-align:left\">{}</td></tr>", io::xml_escape(key),
+                     io::xml_escape(value));
+  };
+  row("antpose", p.antpose);
+  row("made (UTC)", p.created_utc);
+  row("command", "antpose " + p.command);
+  for (const auto& i : p.inputs) row(i.role, fmt::format("{} (SHA-256 {})", i.path, i.sha256));
+  if (p.device_id)
+    row("device", fmt::format("{} (profile SHA-256 {})", *p.device_id, p.device_profile_sha256.value_or("")));
+  for (const auto& [name, value] : p.options.items())
+    row(name, value.is_string() ? value.get<std::string>() : value.dump());
+  return h + "</table>";
+}
+
+std::string html_page(const Capture& capture, const NonContactResult& r, const std::vector<std::string>& overlays,
+                      const store::Provenance& provenance) {
   std::string h =
       "<!doctype html><html><head><meta charset=\"utf-8\"><title>antpose measurement</title><style>"
       "body{font-family:sans-serif;margin:2em;max-width:1200px}table{border-collapse:collapse}"
@@ -225,13 +244,13 @@ std::string html_page(const Capture& capture, const NonContactResult& r, const s
     for (const auto& s : r.skipped) h += "<li>" + io::xml_escape(s) + "</li>";
     h += "</ul>";
   }
-  return h + "</body></html>\n";
+  return h + provenance_table(provenance) + "</body></html>\n";
 }
 
 }  // namespace
 
 void write_report(const fs::path& folder, const Capture& capture, const NonContactSetup& setup,
-                  const NonContactResult& result, bool overwrite) {
+                  const NonContactResult& result, const store::Provenance& provenance, bool overwrite) {
   if (fs::exists(folder) && !fs::is_empty(folder) && !overwrite)
     throw InputError(folder, "already exists and is not empty; choose a new report folder or add --force");
   io::write_folder_atomic(folder, true, [&](const fs::path& tmp) {
@@ -265,8 +284,10 @@ void write_report(const fs::path& folder, const Capture& capture, const NonConta
         model::write_ply(m.region.cloud_board, tmp / fmt::format("antenna_{}_points.ply", k + 1));
       if (!m.model_board.empty()) model::write_ply(m.model_board, tmp / fmt::format("antenna_{}_model.ply", k + 1));
     }
-    io::write_text_atomic(tmp / "result.json", to_json(result).dump(2) + "\n");
-    io::write_text_atomic(tmp / "index.html", html_page(capture, result, overlays));
+    nlohmann::json j = to_json(result);
+    j["provenance"] = store::to_json(provenance);
+    io::write_text_atomic(tmp / "result.json", j.dump(2) + "\n");
+    io::write_text_atomic(tmp / "index.html", html_page(capture, result, overlays, provenance));
   });
 }
 

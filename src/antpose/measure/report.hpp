@@ -15,11 +15,14 @@
 #include <filesystem>
 
 #include "antpose/measure/non_contact.hpp"
+#include "antpose/store/provenance.hpp"
 
 namespace antpose::measure {
 
-/// InputError when `folder` exists, is not empty and `overwrite` is false.
+/// The report folder: index.html (the table, the σ budget, warnings, plan views, overlays, what
+/// produced it), result.json with `provenance`, the overlays and the PLY clouds. InputError when
+/// `folder` exists, is not empty and `overwrite` is false.
 void write_report(const std::filesystem::path& folder, const Capture& capture, const NonContactSetup& setup,
-                  const NonContactResult& result, bool overwrite);
+                  const NonContactResult& result, const store::Provenance& provenance, bool overwrite);
 
 }  // namespace antpose::measure

@@ -16,6 +16,7 @@
 #include "antpose/sim/board_texture.hpp"
 #include "antpose/sim/capture_geometry.hpp"
 #include "antpose/sim/random.hpp"
+#include "antpose/geomag/earth_model.hpp"
 
 namespace antpose::sim {
 namespace fs = std::filesystem;
@@ -436,7 +437,7 @@ SimulatedCapture simulate_capture(const CaptureScenario& sc, const fs::path& scr
   imu.trajectory = tr;
   imu.phone = d.phone;
   imu.field_world_uT = field_world_uT;
-  imu.gravity = normal_gravity(sc.site.lat_deg, sc.site.alt_m);
+  imu.gravity = geomag::normal_gravity(sc.site.lat_deg, sc.site.alt_m);
   imu.site = sc.site;
   imu.time_origin = sc.site.date + "T02:00:00Z";
   imu.kind = has_board ? to_string(sc.scenario) : "imu-log";  // no capture kind for "photos of a room" yet

@@ -11,6 +11,7 @@
 #include "antpose/io/csv.hpp"
 #include "antpose/io/yaml_util.hpp"
 #include "antpose/sim/random.hpp"
+#include "antpose/geomag/earth_model.hpp"
 
 namespace antpose::sim {
 
@@ -520,7 +521,7 @@ Capture simulate_imu(const ImuSimulation& sim) {
     throw std::invalid_argument("simulate_imu: earth_rotation needs a site (latitude)");
   const double T = tr.duration();
   const Vec3 g_world(0.0, 0.0, -sim.gravity);
-  const Vec3 earth_world = sim.earth_rotation ? earth_rate_enu(sim.site->lat_deg) : Vec3::Zero();
+  const Vec3 earth_world = sim.earth_rotation ? geomag::earth_rate_enu(sim.site->lat_deg) : Vec3::Zero();
 
   Capture c;
   c.kind = sim.kind;
@@ -670,19 +671,6 @@ Vec3 dipole_field_uT(const MagneticDipole& dipole, const Vec3& p_world) {
   const Vec3 u = r.norm() > 0.0 ? Vec3(r / r.norm()) : Vec3::UnitZ();
   // 1e-7 T·m/A = 0.1 µT·m/A.
   return 0.1 * (3.0 * u * u.dot(dipole.moment_Am2) - dipole.moment_Am2) / (d * d * d);
-}
-
-double normal_gravity(double lat_deg, double alt_m) {
-  // WGS84 (NIMA TR8350.2): γ = γe (1 + k sin²φ) / sqrt(1 − e² sin²φ).
-  constexpr double gamma_e = 9.7803253359, k = 0.00193185265241, e2 = 6.69437999013e-3;
-  const double s2 = std::pow(std::sin(deg2rad(lat_deg)), 2);
-  return gamma_e * (1.0 + k * s2) / std::sqrt(1.0 - e2 * s2) - 3.086e-6 * alt_m;
-}
-
-Vec3 earth_rate_enu(double lat_deg) {
-  constexpr double omega_e = 7.292115e-5;  // rad/s, WGS84
-  const double phi = deg2rad(lat_deg);
-  return {0.0, omega_e * std::cos(phi), omega_e * std::sin(phi)};
 }
 
 }  // namespace antpose::sim

@@ -209,7 +209,7 @@ struct ImuSimulation {
   Vec3 field_world_uT = Vec3(0.0, 24.0, -41.569219381653056);  // ENU, µT (48 µT, dip 60°, no declination)
   std::vector<MagneticDisturbance> disturbances;
   std::vector<MagneticDipole> dipoles;  // position-dependent disturbance at the device's position
-  double gravity = 9.80665;             // m/s^2 (see normal_gravity for a site)
+  double gravity = 9.80665;             // m/s^2 (see geomag::normal_gravity for a site)
   bool earth_rotation = false;          // add Earth's rate (needs `site` for the latitude)
   std::optional<Site> site;
   std::optional<std::string> time_origin;  // ISO-8601 UTC of t = 0
@@ -247,12 +247,5 @@ std::string contact_scene_yaml(const ContactTruth& truth);
 /// "contact", and generated_files["truth/scene.yaml"] (metadata truth.scene names it).
 Capture simulate_contact(ImuSimulation sim, const Mat3& R_world_antenna,
                          ContactPlacement placement = ContactPlacement::kTopUp, const ContactMotion& motion = {});
-
-/// Normal gravity on the WGS84 ellipsoid (Somigliana) with the free-air correction
-/// −3.086e-6 s^-2 · h; m/s^2 (NIMA TR8350.2 §4.2).
-double normal_gravity(double lat_deg, double alt_m);
-
-/// Earth's rotation rate in ENU at a latitude: Ω (0, cos φ, sin φ), rad/s.
-Vec3 earth_rate_enu(double lat_deg);
 
 }  // namespace antpose::sim

@@ -27,27 +27,12 @@
 
 #include <nlohmann/json.hpp>
 
+#include "antpose/store/content_hash.hpp"
 #include "antpose/store/device_profile.hpp"
 
 struct sqlite3;
 
 namespace antpose::store {
-
-/// One input file of a calibration, identified by content.
-struct InputFile {
-  std::string path;    // as given (a capture folder's files: folder/relative path)
-  std::string sha256;  // lowercase hex
-  std::uintmax_t size = 0;  // bytes
-};
-
-/// SHA-256 (FIPS 180-4, via OpenSSL EVP) of a file's bytes, lowercase hex. InputError when unreadable.
-std::string sha256_file(const std::filesystem::path& file);
-/// Every regular file under `path` (recursively, sorted by name), or `path` itself when it is a file.
-std::vector<InputFile> hash_inputs(const std::filesystem::path& path);
-nlohmann::json to_json(const std::vector<InputFile>& inputs);
-
-/// ISO 8601 UTC timestamp of now, with milliseconds.
-std::string utc_now();
 
 struct CalibrationRun {
   std::int64_t run_id = 0;      // assigned by record_run
