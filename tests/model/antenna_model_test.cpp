@@ -257,6 +257,10 @@ TEST(AntennaModel, PointCloudIsNotAModel) {
   write_ply(cloud, dir / "points.ply");
   EXPECT_THAT(test::input_error([&] { load_antenna_model(dir / "points.ply", std::nullopt, Units::kMetres, true); }),
               HasSubstr("points.ply: the mesh has no faces"));
+  // Faces whose corners lie on a line: triangles, but no surface.
+  test::write_file(dir / "flat.obj", "v 0 0 0\nv 0.5 0 0\nv 1.3 0 0\nf 1 2 3\nf 3 2 1\n");
+  EXPECT_THAT(test::input_error([&] { load_antenna_model(dir / "flat.obj", std::nullopt, Units::kMetres, true); }),
+              HasSubstr("flat.obj: the mesh's 2 faces have no area"));
 }
 
 TEST(AntennaModel, PrincipalAxesFindTheLongAxisUpToSign) {

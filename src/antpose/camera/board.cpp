@@ -140,6 +140,17 @@ BoardSpec parse_board(const std::string& text, const fs::path& file) {
                        fmt::format("dictionary '{}' is not an OpenCV ArUco dictionary; expected one of {}", b.dictionary,
                                    names));
     }
+    // A ChArUco board has a marker in every other square, each of them distinct: a board with
+    // more markers than its dictionary holds cannot exist (and its detection would search for
+    // minutes per photo).
+    const int markers = b.cols * b.rows / 2;
+    const int available = cv::aruco::getPredefinedDictionary(aruco_dictionary_id(b.dictionary))->bytesList.rows;
+    if (markers > available)
+      throw InputError(
+          file, io::line_of(dict),
+          fmt::format("a {}×{} ChArUco board has {} markers but the dictionary {} holds {}: check cols and "
+                      "rows, or the dictionary",
+                      b.cols, b.rows, markers, b.dictionary, available));
   }
   return b;
 }

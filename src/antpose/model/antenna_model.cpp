@@ -296,6 +296,14 @@ AntennaModel load_antenna_model(const fs::path& mesh_file, const std::optional<f
     throw InputError(mesh_file,
                      "the mesh has no faces (a point cloud): an antenna model needs triangles, to sample "
                      "its surface and normals from");
+  // Faces of no area (repeated or collinear corners) give no surface to sample: refused here
+  // rather than after the reconstruction has run.
+  const auto extent = bounding_box(mesh);
+  const double size = (extent.second - extent.first).maxCoeff();
+  if (!(surface_area(mesh) > 1e-6 * size * size))
+    throw InputError(mesh_file, fmt::format("the mesh's {} faces have no area (their corners repeat or lie on a line): "
+                                            "an antenna model needs a surface",
+                                            mesh.triangles.size()));
   AntennaModel model;
   model.name = model_name(mesh_file);
   if (box_file) {
