@@ -1,5 +1,6 @@
 // antpose contact: antenna attitude from a phone held flat on the antenna's back plate.
 #include <filesystem>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -9,6 +10,7 @@
 #include "antpose/imu/imu_calibration.hpp"
 #include "antpose/io/text_file.hpp"
 #include "antpose/measure/contact.hpp"
+#include "antpose/store/device_ref.hpp"
 #include "cli_provenance.hpp"
 #include "commands.hpp"
 #include "json_output.hpp"
@@ -23,6 +25,7 @@ struct ContactArgs {
   std::string calibration;
   std::string placement = "top-up";
   std::string json;
+  std::optional<std::string> device, db;
   double max_sigma_deg = kDefaultMaxSigmaDeg;
   bool no_unit_repair = false;
 };
@@ -59,6 +62,20 @@ std::vector<AngleReading> readings(const measure::ContactResult& r) {
           {"roll", r.roll, r.sigma.roll}};
 }
 
+// --device: the phone's profile, whose IMU calibration is applied as --imu-calibration's would be.
+std::optional<store::DeviceRef> device_calibration(const ContactArgs& args, Diagnostics& diagnostics,
+                                                   measure::ContactOptions& options) {
+  if (!args.device) return std::nullopt;
+  if (!args.calibration.empty())
+    throw InputError("--device", "give --device or --imu-calibration, not both: each brings an IMU calibration");
+  auto ref = store::resolve_device_ref(*args.device, args.db ? std::optional<fs::path>(*args.db) : std::nullopt);
+  if (ref.profile.has_imu)
+    options.calibration = ref.profile.imu;
+  else
+    diagnostics.warn(ref.file ? *ref.file : fs::path("--device " + ref.profile.id), 0, kNoImuCalibrationWarning);
+  return ref;
+}
+
 int run_contact(const ContactArgs& args, const CLI::App& verb) {
   measure::ContactOptions options;
   try {
@@ -70,6 +87,7 @@ int run_contact(const ContactArgs& args, const CLI::App& verb) {
   read_options.repair_units = !args.no_unit_repair;
   Diagnostics diagnostics;
   if (!args.calibration.empty()) load_calibration(args.calibration, read_options, diagnostics, options);
+  const auto device = device_calibration(args, diagnostics, options);
   const Capture capture = read_capture(args.capture, diagnostics, read_options);
   print_warnings(diagnostics);
 
@@ -106,6 +124,7 @@ int run_contact(const ContactArgs& args, const CLI::App& verb) {
   if (!args.json.empty()) {
     store::Provenance provenance = provenance_of(verb).input("capture", args.capture);
     if (!args.calibration.empty()) provenance.input("IMU calibration", args.calibration);
+    if (device) add_device(provenance, *device);
     provenance.site = capture.site;
     write_json(args.json, measure::to_json(r), provenance);
   }
@@ -125,6 +144,10 @@ void add_contact_command(CLI::App& app) {
   cmd->add_option("--imu-calibration", args->calibration,
                   "IMU calibration: a capture folder (the phone turned in all directions: hard iron (max+min)/2) "
                   "or an antpose-device YAML file");
+  cmd->add_option("--device", args->device,
+                  "the phone: a device id in the database or a profile YAML file, whose IMU calibration is applied "
+                  "(instead of --imu-calibration)");
+  cmd->add_option("--db", args->db, "device database (default as 'antpose device')");
   cmd->add_option("--placement", args->placement, "how the phone lies on the plate: top-up, top-down, top-right, top-left")
       ->capture_default_str();
   add_json_option(cmd, args->json, "write the result");

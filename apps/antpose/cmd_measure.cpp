@@ -161,9 +161,7 @@ int run_measure(const MeasureArgs& a, const CLI::App& verb) {
   if (ref.profile.has_imu) {
     imu::apply(ref.profile.imu, capture);
   } else {
-    diagnostics.warn(where, 0,
-                     "the device has no IMU calibration: the magnetometer's hard iron turns the azimuth by "
-                     "degrees; run 'antpose calibrate imu --device' first");
+    diagnostics.warn(where, 0, kNoImuCalibrationWarning);
   }
 
   measure::NonContactOptions options;

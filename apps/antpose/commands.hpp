@@ -40,6 +40,11 @@ void add_calibrate_joint_command(CLI::App& calibrate);
 void add_simulate_capture_command(CLI::App& simulate);
 void add_bench_measure_command(CLI::App& bench);
 
+/// The warning for a device profile without an IMU calibration, where the compass matters.
+inline constexpr const char* kNoImuCalibrationWarning =
+    "the device has no IMU calibration: the magnetometer's hard iron turns the azimuth by degrees; run 'antpose "
+    "calibrate imu --device' first";
+
 /// Prints each warning as "warning: <file>:<line>: <message>" on stderr.
 void print_warnings(const Diagnostics& diagnostics);
 

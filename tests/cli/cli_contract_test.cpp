@@ -151,6 +151,30 @@ TEST(CliContract, AnAttitudeIsNotReadFromAxesOfAnUnknownFrame) {
                                "Android's device frame"));
 }
 
+TEST(CliContract, ContactTakesTheDevicesImuCalibration) {
+  test::TempDir dir;
+  const fs::path device = dir / "phone.yaml";
+  ASSERT_EQ(test::run_cli(fmt::format("calibrate imu '{}' --sensors mag -o '{}'",
+                                      test::source_path("examples/imu-calibration-sample").string(), device.string()))
+                .status,
+            0);
+  const fs::path cap = test::source_path("examples/contact-sample");
+  const auto by_file =
+      test::run_cli(fmt::format("contact '{}' --imu-calibration '{}' --json -", cap.string(), device.string()));
+  const auto by_device =
+      test::run_cli(fmt::format("contact '{}' --device '{}' --json -", cap.string(), device.string()));
+  ASSERT_EQ(by_file.status, 0) << by_file.err;
+  ASSERT_EQ(by_device.status, 0) << by_device.err;
+  const auto a = nlohmann::json::parse(by_file.out), b = nlohmann::json::parse(by_device.out);
+  EXPECT_EQ(a["azimuth_magnetic_deg"], b["azimuth_magnetic_deg"]);
+  EXPECT_EQ(a["downtilt_deg"], b["downtilt_deg"]);
+  EXPECT_FALSE(b["provenance"]["device"].is_null());
+  const auto both = test::run_cli(
+      fmt::format("contact '{}' --device '{}' --imu-calibration '{}'", cap.string(), device.string(), device.string()));
+  EXPECT_EQ(both.status, 2);
+  EXPECT_THAT(both.err, HasSubstr("--device: give --device or --imu-calibration, not both"));
+}
+
 TEST(CliContract, AResultOverTheSigmaLimitIsWrittenAndExitsFour) {
   test::TempDir dir;
   const fs::path cap = contact_copy(dir);
