@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include "antpose/io/time.hpp"
+#include "support/test_support.hpp"
 
 namespace antpose::io {
 namespace {
@@ -38,6 +39,20 @@ TEST(UtcIso8601, DoubleSecondsKeepTheirResolution) {
   // A difference of two samples equals the difference of their t (exactly here).
   const double later = utc + 0.5;
   EXPECT_EQ(seconds_since(later, origin) - t, later - utc);
+}
+
+// Found by fuzz_capture_yaml and fuzz_thesis_xml: times that int64 nanoseconds cannot hold were
+// multiplied into signed overflow (undefined behaviour) instead of refused.
+TEST(UtcIso8601, TimesBeyondWhatNanosecondsHoldAreRefused) {
+  EXPECT_FALSE(parse_utc_iso8601("4052-06-01T00:00:00Z"));
+  EXPECT_FALSE(parse_utc_iso8601("1600-06-01T00:00:00Z"));
+  EXPECT_TRUE(parse_utc_iso8601("2261-12-31T23:59:59Z"));
+  EXPECT_THAT(test::input_error([] { checked_unix_seconds(1.38884e25, "sensor_0.xml", 7, "<time>"); }),
+              ::testing::HasSubstr("sensor_0.xml:7: <time> 1.38884e+25 is not a UTC time in seconds since 1970"));
+  EXPECT_THAT(test::input_error([] { checked_unix_seconds(-1.0, "time.csv", 2, "system time"); }),
+              ::testing::HasSubstr("system time -1 is not a UTC time"));
+  EXPECT_EQ(checked_unix_seconds(1.6e9, "x", 1, "t"), 1.6e9);
+  EXPECT_THROW(unix_seconds_to_ns_us(1e25), std::invalid_argument);
 }
 
 }  // namespace

@@ -156,7 +156,9 @@ Capture import_phyphox(const fs::path& folder, Diagnostics& diagnostics, const C
       if (csv.rows[i][ce] != "START") continue;
       if (++starts > 1) continue;
       const double exp_t = io::parse_number(csv.rows[i][cx], time_file, csv.lines[i], "experiment time");
-      const double sys_t = io::parse_number(csv.rows[i][cs], time_file, csv.lines[i], "system time");
+      const double sys_t =
+          io::checked_unix_seconds(io::parse_number(csv.rows[i][cs], time_file, csv.lines[i], "system time"), time_file,
+                                   csv.lines[i], "system time");
       c.time_origin = io::format_utc_iso8601(io::unix_seconds_to_ns_us(sys_t), 6);
       t_shift = -exp_t;
       src.assumptions.push_back(fmt::format("time_origin = START system time {} of meta/time.csv (line {}), to the µs; "

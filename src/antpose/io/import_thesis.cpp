@@ -130,7 +130,9 @@ Capture import_thesis_project(const fs::path& in, Diagnostics& diagnostics, cons
   if (auto n = child_ci(root, "name")) src.extra["project"]["name"] = trimmed_text(n);
   if (auto n = child_ci(root, "description")) src.extra["project"]["description"] = trimmed_text(n);
   if (auto n = child_ci(root, "createtime"); n && !trimmed_text(n).empty()) {
-    const double ct = io::parse_number(trimmed_text(n), proj_file, proj.line(n), "<createTime>");
+    const double ct =
+        io::checked_unix_seconds(io::parse_number(trimmed_text(n), proj_file, proj.line(n), "<createTime>"), proj_file,
+                                 proj.line(n), "<createTime>");
     src.extra["project"]["create_time"] = io::format_utc_iso8601(io::unix_seconds_to_ns_us(ct), 6);
   }
 
@@ -149,7 +151,8 @@ Capture import_thesis_project(const fs::path& in, Diagnostics& diagnostics, cons
     if (index < 0 || index != std::floor(index))
       throw InputError(proj_file, line, fmt::format("<index> {} is not a non-negative integer", index));
     Collection col{static_cast<int>(index), 0.0, {}, line};
-    col.utc = required_number(proj, node, "time", "shot time in UTC seconds since 1970");
+    col.utc = io::checked_unix_seconds(required_number(proj, node, "time", "shot time in UTC seconds since 1970"),
+                                       proj_file, line, "<time>");
     if (auto pic = child_ci(node, "picture"); pic && !trimmed_text(pic).empty()) {
       col.picture = trimmed_text(pic);
       if (!fs::is_regular_file(io::path_inside(folder, col.picture, {proj_file, proj.line(pic), "picture"})))
@@ -182,10 +185,11 @@ Capture import_thesis_project(const fs::path& in, Diagnostics& diagnostics, cons
         const std::size_t line = x.line(fr);
         const auto value = child_ci(fr, "value");
         if (!value) throw InputError(x.file, line, "<frame> has no <value> with x, y, z");
-        Frame f{required_number(x, fr, "time", "UTC seconds since 1970"),
-                Vec3(required_number(x, value, "x", "a number"), required_number(x, value, "y", "a number"),
-                     required_number(x, value, "z", "a number")),
-                fi, line};
+        Frame f{
+            io::checked_unix_seconds(required_number(x, fr, "time", "UTC seconds since 1970"), x.file, line, "<time>"),
+            Vec3(required_number(x, value, "x", "a number"), required_number(x, value, "y", "a number"),
+                 required_number(x, value, "z", "a number")),
+            fi, line};
         if (f.utc < prev)
           throw InputError(x.file, line, fmt::format("frame time {} goes backwards (previous frame of channel {} at {})",
                                                      io::format_number(f.utc), name, io::format_number(prev)));

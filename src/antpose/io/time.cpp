@@ -3,8 +3,12 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
+#include <stdexcept>
 
 #include <fmt/format.h>
+
+#include "antpose/core/error.hpp"
 
 namespace antpose::io {
 namespace {
@@ -87,10 +91,34 @@ std::optional<std::int64_t> parse_utc_iso8601(std::string_view s) {
   if (pos != s.size()) return std::nullopt;
   const std::int64_t day_s = static_cast<std::int64_t>(sys_days{ymd}.time_since_epoch().count()) * 86400;
   const std::int64_t secs = day_s + h * 3600 + mi * 60 + sec - offset_s;
+  constexpr std::int64_t kMaxSeconds = std::numeric_limits<std::int64_t>::max() / kNsPerSecond - 1;
+  if (secs > kMaxSeconds || secs < -kMaxSeconds) return std::nullopt;  // no int64 ns for it
   return secs * kNsPerSecond + frac_ns;
 }
 
+namespace {
+
+void require_unix_seconds(double unix_seconds, const char* function) {
+  if (!(unix_seconds >= 0.0 && unix_seconds <= kMaxUnixSeconds))
+    throw std::invalid_argument(
+        fmt::format("{}: {} s is no Unix time from 1970 to 2261 (check it where it is read: "
+                    "checked_unix_seconds)",
+                    function, unix_seconds));
+}
+
+}  // namespace
+
+double checked_unix_seconds(double unix_seconds, const std::filesystem::path& file, std::size_t line,
+                            std::string_view what) {
+  if (!(unix_seconds >= 0.0 && unix_seconds <= kMaxUnixSeconds))
+    throw InputError(file, line,
+                     fmt::format("{} {} is not a UTC time in seconds since 1970 (expected 0 to {:.1e})", what,
+                                 unix_seconds, kMaxUnixSeconds));
+  return unix_seconds;
+}
+
 std::int64_t unix_seconds_to_ns_us(double unix_seconds, Rounding rounding) {
+  require_unix_seconds(unix_seconds, "unix_seconds_to_ns_us");
   const double whole = std::floor(unix_seconds);
   const double frac = unix_seconds - whole;  // exact (Sterbenz): no bits are lost by the split
   const double us_real = frac * 1e6;
@@ -99,6 +127,7 @@ std::int64_t unix_seconds_to_ns_us(double unix_seconds, Rounding rounding) {
 }
 
 double seconds_since(double unix_seconds, std::int64_t origin_ns) {
+  require_unix_seconds(unix_seconds, "seconds_since");
   const double whole = std::floor(unix_seconds);
   const double frac = unix_seconds - whole;
   const std::int64_t origin_s = floor_div(origin_ns, kNsPerSecond);
