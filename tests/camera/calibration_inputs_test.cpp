@@ -219,6 +219,7 @@ robust:
       {"flip_vertical: maybe\n", ":1: flip_vertical is 'maybe', expected true or false"},
       {"board: {type: chessboard, cols: 9, rows: 6, square_m: -1}\n", ":1: board: square_m is -1 m"},
       {"intrinsics_guess: nowhere.yaml\n", "nowhere.yaml: camera file not found"},
+      {"? [a, b]\n: 1\n", ":1: a key is a list of 2, expected a name"},
   };
   for (const auto& [text, message] : bad) {
     test::write_file(file, text);

@@ -210,7 +210,12 @@ bool yaml_bool(const YAML::Node& n, const fs::path& file, const std::string& key
 void check_keys(const YAML::Node& map, const std::set<std::string>& known, const fs::path& file,
                 const std::string& where) {
   for (const auto& kv : map) {
-    const std::string key = kv.first.as<std::string>();
+    if (!kv.first.IsScalar())
+      throw InputError(
+          file, io::line_of(kv.first),
+          fmt::format("a key{} is {}, expected a name",
+                      where.empty() ? "" : " in '" + where.substr(0, where.size() - 1) + "'", io::show(kv.first)));
+    const std::string key = kv.first.Scalar();
     if (!known.count(key)) {
       std::string list;
       for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;

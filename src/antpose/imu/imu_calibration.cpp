@@ -84,8 +84,8 @@ ImuCalibration parse_imu_calibration(const std::string& text, const fs::path& fi
                      fmt::format("format version {} is not supported; this antpose reads version 1 to {}", version,
                                  ImuCalibration::kFormatVersion));
   if (const auto dev = section(d, "device", file, "device")) {
-    if (dev["model"]) c.device_model = dev["model"].as<std::string>();
-    if (dev["id"]) c.device_id = dev["id"].as<std::string>();
+    if (dev["model"]) c.device_model = io::yaml_string(dev["model"], file, "device.model");
+    if (dev["id"]) c.device_id = io::yaml_string(dev["id"], file, "device.id");
   }
   const auto imu = section(d, "imu", file, "imu");
   if (!imu) throw InputError(file, "no 'imu' section (expected imu: {magnetometer: ..., accelerometer: ..., gyroscope: ...})");

@@ -273,7 +273,8 @@ YAML::Node metadata_yaml(const Capture& c) {
                                                  "sensor_frame", "site", "truth"};
   if (c.metadata.IsMap())
     for (const auto& kv : c.metadata) {
-      const auto key = kv.first.as<std::string>();
+      if (!kv.first.IsScalar()) continue;  // a key that is no name (a YAML map or list) is not kept
+      const std::string& key = kv.first.Scalar();
       if (!kManaged.contains(key) && !out[key]) out[key] = YAML::Clone(kv.second);
     }
   return out;

@@ -56,8 +56,9 @@ StreamSummary summarize_stream(const Stream& s, double gap_factor) {
 
 CaptureSummary summarize(const Capture& c, double gap_factor) {
   CaptureSummary out;
-  if (c.metadata.IsMap() && c.metadata["source"] && c.metadata["source"].IsMap() && c.metadata["source"]["format"])
-    out.format = c.metadata["source"]["format"].as<std::string>();
+  if (c.metadata.IsMap() && c.metadata["source"] && c.metadata["source"].IsMap() &&
+      c.metadata["source"]["format"].IsScalar())
+    out.format = c.metadata["source"]["format"].Scalar();
   out.kind = c.kind;
   out.device_model = c.device_model;
   out.device_id = c.device_id;
