@@ -49,11 +49,11 @@ printf '%s\n' "${TARGETS[@]}" | xargs -P"$(nproc)" -I{} bash -c 'run {}' | tee "
   echo "fuzzing $(git describe --always --dirty), ${SECONDS_PER_TARGET} s per target, ASan+UBSan, $(date -u +%FT%TZ)"
   for t in "${TARGETS[@]}"; do
     log="$BUILD/logs/$t.log"
-    runs=$(grep -o 'stat::number_of_executed_units: [0-9]*' "$log" | awk '{print $2}')
-    cov=$(grep -o 'cov: [0-9]*' "$log" | tail -1 | awk '{print $2}')
-    ft=$(grep -o 'ft: [0-9]*' "$log" | tail -1 | awk '{print $2}')
+    runs=$(grep -o 'stat::number_of_executed_units: [0-9]*' "$log" | awk '{print $2}' || true)
+    cov=$(grep -o 'cov: [0-9]*' "$log" | tail -1 | awk '{print $2}' || true)
+    ft=$(grep -o 'ft: [0-9]*' "$log" | tail -1 | awk '{print $2}' || true)
     corpus=$(ls "$BUILD/corpus/$t" | wc -l)
-    status=$(grep "^$t " "$BUILD/fuzz-status.txt" | awk '{print $2}')
+    status=$(grep "^$t " "$BUILD/fuzz-status.txt" | awk '{print $2}' || true)
     printf '%-20s %-7s executions %-10s coverage (edges) %-6s features %-7s corpus %s\n' "$t" "$status" "${runs:-?}" "${cov:-?}" "${ft:-?}" "$corpus"
   done
 } | tee "$BUILD/fuzz-report.txt"
