@@ -15,7 +15,7 @@
 
 namespace antpose::fuzz {
 
-/// A folder of this process, made once and emptied of nothing: each input overwrites its files.
+/// A folder of this process, made on first use: each input overwrites its files.
 inline const std::filesystem::path& scratch() {
   static const std::filesystem::path dir = [] {
     auto d = std::filesystem::temp_directory_path() / ("antpose-fuzz-" + std::to_string(::getpid()));

@@ -19,7 +19,7 @@ std::string charuco(int cols, int rows, const char* dictionary) {
 TEST(Board, AChArUcoBoardHasNoMoreMarkersThanItsDictionary) {
   const BoardSpec b = parse_board(charuco(10, 10, "DICT_4X4_50"), "board.yaml");  // 50 markers, 50 in the dictionary
   EXPECT_EQ(b.cols, 10);
-  // 1000 × 1000 squares with DICT_4X4_50 once took minutes per photo before failing.
+  // Such a board cannot exist, and searching photos for it would take minutes each.
   EXPECT_THAT(test::input_error([] { parse_board(charuco(1000, 1000, "DICT_4X4_50"), "board.yaml"); }),
               HasSubstr("board.yaml:6: a 1000×1000 ChArUco board has 500000 markers but the dictionary DICT_4X4_50 "
                         "holds 50"));

@@ -43,8 +43,7 @@ TEST(CliContract, MisuseIsBadInputAndAMistypedVerbIsNamed) {
 }
 
 TEST(CliContract, ANumberOptionIsCheckedBeforeAnyWork) {
-  // A NaN once reached Ceres' covariance (a crash), and a fixed offset of 5 s gave a rotation
-  // 131° off with a σ of 0.05°: the option is refused before the capture is read.
+  // A non-finite offset, or one outside the search bracket, is refused before the capture is read.
   for (const char* offset : {"nan", "5", "inf"}) {
     const auto r =
         test::run_cli(fmt::format("calibrate joint no-capture --device p.yaml --time-offset {} "

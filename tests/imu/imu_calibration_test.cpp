@@ -116,7 +116,7 @@ INSTANTIATE_TEST_SUITE_P(
         BadFile{"format: antpose-device\nversion: 1\nimu: [1, 2]\n",
                 "bad.yaml:3: 'imu' is a list of 2, expected a map"},
         BadFile{"format: antpose-device\nversion: 1\nimu: {magnetometer: [\n", "not valid YAML"},
-        // Found by fuzz_device_yaml: a map where a name belongs escaped as yaml-cpp's exception.
+        // A map where a name belongs is bad input like any other.
         BadFile{"format: antpose-device\nversion: 1\ndevice:\n  id: {a: 1}\nimu: {}\n", "bad.yaml:4: device.id"}));
 
 TEST(ImuCalibration, MissingFile) {

@@ -93,7 +93,7 @@ TEST(MeasureRoi, ParsesAndNamesBadValues) {
   EXPECT_EQ(r.roi.height, 1500);
   EXPECT_THAT(test::input_error([] { parse_roi("img.jpg:1,2,3"); }), HasSubstr("is not IMAGE:x,y,w,h"));
   EXPECT_THAT(test::input_error([] { parse_roi("1,2,3,4"); }), HasSubstr("is not IMAGE:x,y,w,h"));
-  // sscanf's %d would wrap 4294968763 to 1467 and measure that.
+  // A number beyond int is refused, not wrapped into another rectangle.
   EXPECT_THAT(test::input_error([] { parse_roi("img.jpg:4294968763,2,30,40"); }),
               HasSubstr("'img.jpg:4294968763,2,30,40': 4294968763 is far beyond any photo's pixels"));
   EXPECT_THAT(test::input_error([] { parse_roi("img.jpg:1,2,30,40x"); }), HasSubstr("is not IMAGE:x,y,w,h"));

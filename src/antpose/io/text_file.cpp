@@ -64,18 +64,25 @@ fs::path temporary_sibling(const fs::path& file) {
   return file.parent_path() / fmt::format(".{}.tmp-{:08x}", file.filename().string(), rd());
 }
 
-// The path a chain of symbolic links ends at (relative links resolved against their folder), so
-// that an output written through a link replaces the file it names, never the link.
+// The path the symbolic link `p` names (relative links resolved against its folder), or nothing
+// when `p` is no link or cannot be read.
+std::optional<fs::path> link_target(const fs::path& p) {
+  std::error_code ec;
+  if (!fs::is_symlink(fs::symlink_status(p, ec))) return std::nullopt;
+  const fs::path next = fs::read_symlink(p, ec);
+  if (ec) return std::nullopt;
+  return next.is_absolute() ? next : p.parent_path() / next;
+}
+
+// The path a chain of symbolic links ends at, so that an output written through a link replaces
+// the file it names, never the link.
 fs::path follow_links(const fs::path& path) {
   fs::path p = path;
-  for (int hops = 0;; ++hops) {
-    std::error_code ec;
-    if (!fs::is_symlink(fs::symlink_status(p, ec))) return p;
+  for (int hops = 0; const auto next = link_target(p); ++hops) {
     if (hops == 40) throw OutputError(path, "is a loop of symbolic links");
-    const fs::path next = fs::read_symlink(p, ec);
-    if (ec) throw OutputError(path, fmt::format("cannot follow the symbolic link ({})", ec.message()));
-    p = next.is_absolute() ? next : p.parent_path() / next;
+    p = *next;
   }
+  return p;
 }
 
 // The descriptor a path such as /dev/stdout or /dev/fd/3 names (through /proc/self/fd/N). Such
@@ -83,16 +90,11 @@ fs::path follow_links(const fs::path& path) {
 // and a file behind it is never replaced by a new one.
 std::optional<int> descriptor_named(const fs::path& path) {
   static const std::regex kDescriptor("/(dev|proc/self)/fd/([0-9]{1,9})");
-  fs::path p = path;
-  for (int hops = 0; hops <= 40; ++hops) {
+  std::optional<fs::path> p = path;
+  for (int hops = 0; p && hops <= 40; ++hops, p = link_target(*p)) {
     std::smatch m;
-    const std::string text = p.lexically_normal().string();
+    const std::string text = p->lexically_normal().string();
     if (std::regex_match(text, m, kDescriptor)) return std::stoi(m[2].str());
-    std::error_code ec;
-    if (!fs::is_symlink(fs::symlink_status(p, ec))) return std::nullopt;
-    const fs::path next = fs::read_symlink(p, ec);
-    if (ec) return std::nullopt;
-    p = next.is_absolute() ? next : p.parent_path() / next;
   }
   return std::nullopt;
 }
