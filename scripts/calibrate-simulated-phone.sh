@@ -26,6 +26,6 @@ $A calibrate imu "$W/tumble" --device "$P" --sensors mag
 $A simulate capture -o "$W/camera" --scenario camera-calibration --seed "$SEED" $CAMERA
 $A calibrate camera "$W/camera" --device "$P"
 $A simulate capture -o "$W/joint" --scenario joint-calibration --seed "$SEED" $CAMERA
-$A calibrate joint "$W/joint" --device "$P" --method reference-free --param gyro_trapezoid=1 --json "$W/joint.json"
+$A calibrate joint "$W/joint" --device "$P" --solver reference-free --param gyro_trapezoid=1 --json "$W/joint.json"
 cp "$P" "$OUT.tmp"
 mv "$OUT.tmp" "$OUT"

@@ -24,6 +24,7 @@
 #include "antpose/orientation/rest_benchmark.hpp"
 #include "cli_provenance.hpp"
 #include "commands.hpp"
+#include "option_checks.hpp"
 #include "json_output.hpp"
 
 namespace antpose::cli {
@@ -284,9 +285,8 @@ void add_bench_command(CLI::App& app) {
   auto oargs = std::make_shared<OrientationBenchArgs>();
   auto* ob = bench->add_subcommand("orientation", "score every orientation estimator against captures with truth");
   ob->add_option("dirs", oargs->dirs, "capture folders, or folders of capture folders")->required();
-  ob->add_option("--methods", oargs->methods,
-                 fmt::format("comma-separated estimators (default: all: {})",
-                             fmt::join(orientation::estimator_names(), ",")));
+  add_orientation_method_option(*ob, oargs->methods, "estimators to score (default: all)", {true, {}, {}});
+  add_renamed_option(*ob, "--methods", "--method");
   add_json_option(ob, oargs->json, "write the per-trial and mean results");
   ob->add_option("--wmm", oargs->wmm, "extra WMM coefficient files for the declination (repeatable; with the built-in "
                                       "WMM2025, the model valid for the capture date is used, else the nearest epoch)");

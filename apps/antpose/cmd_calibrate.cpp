@@ -1,5 +1,5 @@
 // antpose calibrate: per-device sensor calibration.
-//   antpose calibrate imu CAPTURE -o device.yaml [--sensors acc,gyro,mag] [--method thesis|full] [--force]
+//   antpose calibrate imu CAPTURE -o device.yaml [--sensors acc,gyro,mag] [--error-model thesis|full] [--force]
 //   antpose calibrate imu CAPTURE --device ID|FILE [--db PATH] [-o device.yaml] ...   (stored with the device)
 //   antpose calibrate allan CAPTURE [--stream gyroscope] [--json OUT] [--plot OUT.svg]
 #include <filesystem>
@@ -14,6 +14,7 @@
 #include "antpose/io/text_file.hpp"
 #include "cli_provenance.hpp"
 #include "commands.hpp"
+#include "option_checks.hpp"
 #include "json_output.hpp"
 #include "device_calibration.hpp"
 
@@ -24,7 +25,7 @@ namespace fs = std::filesystem;
 struct ImuArgs {
   std::string capture, output;
   std::string sensors = "acc,gyro,mag";
-  std::string method = "full";
+  std::string error_model = "full";
   std::optional<double> gravity;
   bool force = false;
   DeviceOption device;
@@ -39,7 +40,7 @@ void run_imu_device(const ImuArgs& args, const calibration::CalibrateImuOptions&
     throw InputError(args.output,
                      "-o: exists; with --device the file receives the device's whole profile. Use "
                      "--force to replace it, or another name");
-  nlohmann::json settings = {{"sensors", args.sensors}, {"method", args.method}, {"capture", args.capture}};
+  nlohmann::json settings = {{"sensors", args.sensors}, {"error_model", args.error_model}, {"capture", args.capture}};
   if (args.gravity) settings["gravity_m_s2"] = *args.gravity;
   Diagnostics diagnostics;
   run_calibration(device, "imu", settings, {args.capture}, diagnostics, [&] {
@@ -63,7 +64,8 @@ void run_imu_device(const ImuArgs& args, const calibration::CalibrateImuOptions&
       current.imu.device_id = current.id;
       current.has_imu = true;
     };
-    fmt::print("IMU calibration of {} (method {})\n{}", args.capture, args.method, calibration::describe(result));
+    fmt::print("IMU calibration of {} (error model {})\n{}", args.capture, args.error_model,
+               calibration::describe(result));
     if (!args.output.empty()) {
       store::DeviceProfile after = device.profile;
       outcome.apply(after);
@@ -77,7 +79,7 @@ void run_imu_device(const ImuArgs& args, const calibration::CalibrateImuOptions&
 void run_imu(const ImuArgs& args) {
   calibration::CalibrateImuOptions options;
   calibration::parse_sensors(args.sensors, options);
-  options.method = calibration::parse_method(args.method);
+  options.method = calibration::parse_method(args.error_model);
   options.gravity = args.gravity;
   if (const auto device = args.device.resolve()) return run_imu_device(args, options, *device);
   if (args.output.empty()) throw InputError("-o", "no output given: pass -o device.yaml and/or --device ID|FILE");
@@ -90,7 +92,7 @@ void run_imu(const ImuArgs& args) {
     throw;
   }
   print_warnings(diagnostics);
-  fmt::print("IMU calibration of {} (method {})\n{}wrote {}\n", args.capture, args.method,
+  fmt::print("IMU calibration of {} (error model {})\n{}wrote {}\n", args.capture, args.error_model,
              calibration::describe(result), args.output);
 }
 
@@ -155,10 +157,12 @@ void add_calibrate_command(CLI::App& app) {
   imu->add_option("-o,--output", imu_args->output, "device calibration YAML to write (required without --device)");
   imu_args->device.add_to(*imu);
   imu->add_option("--sensors", imu_args->sensors, "comma-separated subset of acc,gyro,mag")->capture_default_str();
-  imu->add_option("--method", imu_args->method,
+  imu->add_option("--error-model", imu_args->error_model,
                   "thesis (normalization, bias, hard iron) or full (9-parameter models, "
                   "ellipsoid)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(CLI::IsMember({"thesis", "full"}));
+  add_renamed_option(*imu, "--method", "--error-model");
   imu->add_option("--gravity", imu_args->gravity,
                   "local gravity, m/s² (default: normal gravity at the capture's site, "
                   "else 9.80665)");

@@ -1,7 +1,7 @@
 // antpose calibrate joint: camera–IMU rotation R_device_camera and time offset from photos of a
 // board (docs/camera-imu.md).
-//   antpose calibrate joint CAPTURE [--camera camera.yaml] [--device ID|FILE] [--method reference-free|thesis|both]
-//       [--orientation antpose[,antpose-smoother,...]] [--param k=v ...] [--time-offset S]
+//   antpose calibrate joint CAPTURE [--camera camera.yaml] [--device ID|FILE] [--solver reference-free|thesis|both]
+//       [--method antpose[,antpose-smoother,...]] [--param k=v ...] [--time-offset S]
 //       [--fixed-time-offset] [--json OUT]
 #include <filesystem>
 #include <memory>
@@ -22,6 +22,7 @@
 #include "antpose/orientation/estimator.hpp"
 #include "cli_provenance.hpp"
 #include "commands.hpp"
+#include "option_checks.hpp"
 #include "json_output.hpp"
 #include "progress.hpp"
 #include "device_calibration.hpp"
@@ -33,8 +34,8 @@ namespace fs = std::filesystem;
 struct JointArgs {
   std::string capture, camera, json;
   DeviceOption device;
-  std::string method = "both";
-  std::string orientation = "antpose";
+  std::string solver = "both";
+  std::string orientation_methods = "antpose";
   std::vector<std::string> params;
   double time_offset = 0.0;
   bool fixed_time_offset = false;
@@ -97,7 +98,7 @@ CalibrationOutcome joint_calibration(const JointArgs& args, const CLI::App& verb
       calibration::check_board_reference(*reference, placements);
       break;
     }
-  if (args.method == "thesis" && !reference)
+  if (args.solver == "thesis" && !reference)
     throw InputError(root / "board_reference.csv", "missing: the thesis method needs the level/compass angles");
 
   // The stages take up to a minute: each is reported as it ends (progress.hpp).
@@ -125,7 +126,7 @@ CalibrationOutcome joint_calibration(const JointArgs& args, const CLI::App& verb
   std::optional<double> offset_for_thesis;
   CalibrationOutcome outcome;
   std::optional<store::CameraImuCalibration> stored;
-  if (args.method != "thesis") {
+  if (args.solver != "thesis") {
     calibration::ReferenceFreeOptions options;
     options.time_offset_start_s = args.time_offset;
     options.estimate_time_offset = !args.fixed_time_offset;
@@ -202,7 +203,7 @@ CalibrationOutcome joint_calibration(const JointArgs& args, const CLI::App& verb
     if (r.reference_check) rf["reference_check"] = table_json(*r.reference_check);
     j["reference_free"] = rf;
   }
-  if (args.method != "reference-free" && reference) {
+  if (args.solver != "reference-free" && reference) {
     calibration::ThesisOptions options;
     options.time_offset_s = offset_for_thesis.value_or(args.time_offset);
     std::vector<calibration::ThesisCalibration> results;
@@ -218,7 +219,7 @@ CalibrationOutcome joint_calibration(const JointArgs& args, const CLI::App& verb
                                rad2deg(std::sqrt(r.covariance(2, 2)))}},
                              {"optimised", table_json(r.optimised)},
                              {"nominal", table_json(r.nominal)}});
-    if (!stored) {  // --method thesis: the first orientation method's result is the device's
+    if (!stored) {  // --solver thesis: the first orientation method's result is the device's
       const auto& r = results.front();
       stored = store::CameraImuCalibration{r.R_device_camera, r.covariance.diagonal().cwiseMax(0.0).cwiseSqrt(),
                                            options.time_offset_s, std::nullopt, "thesis"};
@@ -241,16 +242,12 @@ CalibrationOutcome joint_calibration(const JointArgs& args, const CLI::App& verb
 }
 
 void run_joint(const JointArgs& args, const CLI::App& verb) {
-  if (args.method != "reference-free" && args.method != "thesis" && args.method != "both")
-    throw InputError("--method",
-                     fmt::format("'{}' is not a method, expected reference-free, thesis or both", args.method));
-  const auto methods = split_list(args.orientation);
-  if (methods.empty()) throw InputError("--orientation", "no orientation method given");
+  const auto methods = split_list(args.orientation_methods);
   const auto device = args.device.resolve();
   Diagnostics diagnostics;
   nlohmann::json settings = {{"capture", args.capture},
-                             {"method", args.method},
-                             {"orientation", args.orientation},
+                             {"solver", args.solver},
+                             {"orientation_method", args.orientation_methods},
                              {"params", args.params},
                              {"time_offset_start_s", args.time_offset},
                              {"fixed_time_offset", args.fixed_time_offset}};
@@ -274,12 +271,17 @@ void add_calibrate_joint_command(CLI::App& calibrate) {
       ->required();
   cmd->add_option("--camera", args->camera, "camera YAML with the intrinsics (default: the --device profile's)");
   args->device.add_to(*cmd);
-  cmd->add_option("--method", args->method, "reference-free, thesis (needs board_reference.csv) or both")
+  cmd->add_option("--solver", args->solver,
+                  "calibration solver: reference-free, thesis (needs board_reference.csv) "
+                  "or both")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"reference-free", "thesis", "both"}));
+  add_orientation_method_option(*cmd, args->orientation_methods,
+                                "orientation methods; the first serves the reference-free solver, the thesis "
+                                "tables list each",
+                                {true, {"reference-free", "thesis", "both"}, "the calibration solver is --solver"})
       ->capture_default_str();
-  cmd->add_option("--orientation", args->orientation,
-                  "comma-separated orientation methods; the first serves the reference-free method, the thesis "
-                  "tables list each")
-      ->capture_default_str();
+  add_renamed_option(*cmd, "--orientation", "--method");
   cmd->add_option("--param", args->params, "orientation parameter name=value (repeatable)");
   const calibration::ReferenceFreeOptions defaults;
   cmd->add_option("--time-offset", args->time_offset,

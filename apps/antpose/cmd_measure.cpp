@@ -22,6 +22,7 @@
 #include "antpose/store/device_ref.hpp"
 #include "cli_provenance.hpp"
 #include "commands.hpp"
+#include "option_checks.hpp"
 #include "json_output.hpp"
 #include "progress.hpp"
 #include "usable.hpp"
@@ -213,9 +214,8 @@ void add_measure_command(CLI::App& app) {
   cmd->add_flag("--model-canonical", a->model_canonical, "the mesh is already in the antenna frame (no box file)");
   cmd->add_option("--roi", a->rois, "IMAGE:x,y,w,h: the antenna's rectangle in one photo (px); once per antenna")
       ->required();
-  cmd->add_option("--orientation", a->orientation, "phone orientation method")
-      ->capture_default_str()
-      ->check(CLI::IsMember(orientation::estimator_names()));
+  add_orientation_method_option(*cmd, a->orientation, "phone orientation method")->capture_default_str();
+  add_renamed_option(*cmd, "--orientation", "--method");
   add_json_option(cmd, a->json, "write the result");
   cmd->add_option("--report", a->report, "write a report folder (HTML, overlays, PLY clouds)");
   cmd->add_flag("--force", a->force, "replace an existing report folder");

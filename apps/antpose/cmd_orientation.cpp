@@ -10,6 +10,7 @@
 #include "antpose/geomag/wmm.hpp"
 #include "antpose/orientation/estimator.hpp"
 #include "commands.hpp"
+#include "option_checks.hpp"
 
 namespace antpose::cli {
 namespace {
@@ -56,9 +57,7 @@ void add_orientation_command(CLI::App& app) {
   auto args = std::make_shared<OrientationArgs>();
   auto* cmd = app.add_subcommand("orientation", "estimate the phone's orientation over a capture");
   cmd->add_option("capture", args->capture, "capture folder")->required();
-  cmd->add_option("--method", args->method,
-                  fmt::format("estimator: {}", fmt::join(orientation::estimator_names(), ", ")))
-      ->capture_default_str();
+  add_orientation_method_option(*cmd, args->method, "estimator")->capture_default_str();
   cmd->add_option("--param", args->params, "estimator parameter name=value (repeatable), e.g. beta=0.1");
   cmd->add_option("-o,--output", args->output, "output CSV: t,qw,qx,qy,qz[,tilt_sigma_deg,heading_sigma_deg]")
       ->required();

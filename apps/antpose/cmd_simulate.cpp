@@ -13,6 +13,7 @@
 #include "antpose/sim/imu_simulator.hpp"
 #include "antpose/geomag/earth_model.hpp"
 #include "commands.hpp"
+#include "option_checks.hpp"
 
 namespace antpose::cli {
 namespace {

@@ -52,10 +52,4 @@ void print_warnings(const Diagnostics& diagnostics);
 /// name within each; InputError for a folder that is neither.
 std::vector<std::filesystem::path> capture_folders(const std::vector<std::string>& dirs);
 
-/// A CLI11 check that a number is finite and within [lo, hi] (CLI::Range lets NaN through).
-CLI::Validator finite_within(double lo, double hi, const std::string& unit);
-
-/// The non-empty items of a comma-separated option value ("a,b,,c" → a, b, c).
-std::vector<std::string> split_list(const std::string& text);
-
 }  // namespace antpose::cli

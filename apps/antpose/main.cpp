@@ -3,12 +3,10 @@
 // 3 the data cannot support the measurement, 4 results written but some unusable,
 // 1 an internal fault (a bug to report, or the machine out of memory).
 #include <algorithm>
-#include <cmath>
 #include <cstdio>
 #include <exception>
 #include <filesystem>
 #include <new>
-#include <sstream>
 
 #include <fmt/core.h>
 
@@ -21,32 +19,6 @@ namespace antpose::cli {
 
 void print_warnings(const Diagnostics& diagnostics) {
   for (const auto& w : diagnostics.warnings()) fmt::print(stderr, "warning: {}\n", w.to_string());
-}
-
-std::vector<std::string> split_list(const std::string& text) {
-  std::vector<std::string> out;
-  std::stringstream ss(text);
-  for (std::string item; std::getline(ss, item, ',');)
-    if (!item.empty()) out.push_back(item);
-  return out;
-}
-
-CLI::Validator finite_within(double lo, double hi, const std::string& unit) {
-  return CLI::Validator(
-      [lo, hi, unit](std::string& text) -> std::string {
-        double v = 0.0;
-        try {
-          std::size_t used = 0;
-          v = std::stod(text, &used);
-          if (used != text.size()) return fmt::format("'{}' is not a number", text);
-        } catch (const std::exception&) {
-          return fmt::format("'{}' is not a number", text);
-        }
-        if (!std::isfinite(v) || v < lo || v > hi)
-          return fmt::format("{} must be within [{}, {}] {}", text, lo, hi, unit);
-        return {};
-      },
-      fmt::format("NUMBER in [{}, {}] {}", lo, hi, unit));
 }
 
 namespace {

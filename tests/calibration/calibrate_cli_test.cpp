@@ -120,9 +120,13 @@ TEST(CalibrateCli, BadOutputPathsAndOptions) {
   r = test::run_cli(fmt::format("calibrate imu {} -o {} --sensors acc,compass", cap.string(), (dir / "x.yaml").string()));
   EXPECT_EQ(r.status, 2);
   EXPECT_THAT(r.err, HasSubstr("'compass' is not a sensor"));
-  r = test::run_cli(fmt::format("calibrate imu {} -o {} --method magic", cap.string(), (dir / "x.yaml").string()));
+  r = test::run_cli(fmt::format("calibrate imu {} -o {} --error-model magic", cap.string(), (dir / "x.yaml").string()));
   EXPECT_EQ(r.status, 2);
-  EXPECT_THAT(r.err, HasSubstr("'magic' is not a calibration method"));
+  EXPECT_THAT(r.err, HasSubstr("--error-model: magic not in {thesis,full}"));
+  // The option's name before it was --error-model is refused with the new name.
+  r = test::run_cli(fmt::format("calibrate imu {} -o {} --method full", cap.string(), (dir / "x.yaml").string()));
+  EXPECT_EQ(r.status, 2);
+  EXPECT_THAT(r.err, HasSubstr("--method: this option is now called --error-model (given 'full')"));
 }
 
 TEST(CalibrateCli, ReadOnlyFolderIsAnInputError) {

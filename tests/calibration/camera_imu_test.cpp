@@ -615,10 +615,10 @@ TEST(CameraImu, CliRecoversRotationFromRealBoardPhotos) {
   EXPECT_LT(rad2deg(rotation_distance(R_thesis, X)), 0.3);
 
   // Input errors exit with status 2 and name the problem.
-  const auto bad = test::run_cli(fmt::format("calibrate joint '{}' --camera '{}' --method best",
+  const auto bad = test::run_cli(fmt::format("calibrate joint '{}' --camera '{}' --solver best",
                                              (dir / "joint").string(), intrinsics_file.string()));
   EXPECT_EQ(bad.status, 2);
-  EXPECT_THAT(bad.err, HasSubstr("'best' is not a method, expected reference-free, thesis or both"));
+  EXPECT_THAT(bad.err, HasSubstr("--solver: best not in {reference-free,thesis,both}"));
   const auto no_placement = test::run_cli(fmt::format("calibrate joint '{}' --camera '{}'", folder.string(),
                                                       intrinsics_file.string()));
   EXPECT_EQ(no_placement.status, 2);

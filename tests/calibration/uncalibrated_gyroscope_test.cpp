@@ -222,7 +222,7 @@ fs::path write_device(const test::TempDir& dir, const std::string& name, bool gy
 std::string joint_command(const fs::path& capture, const fs::path& device) {
   const auto intrinsics = test::shared_path("data/camera/opencv-chessboard-9x6/published/left_intrinsics.yml");
   return fmt::format(
-      "calibrate joint '{}' --camera '{}' --device '{}' --method reference-free --param gyro_trapezoid=1",
+      "calibrate joint '{}' --camera '{}' --device '{}' --solver reference-free --param gyro_trapezoid=1",
       capture.string(), intrinsics.string(), device.string());
 }
 

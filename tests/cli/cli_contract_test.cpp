@@ -55,9 +55,35 @@ TEST(CliContract, ANumberOptionIsCheckedBeforeAnyWork) {
 }
 
 TEST(CliContract, AnUnknownOrientationMethodIsRefusedBeforeAnyWorkUnderItsOwnName) {
-  const auto r = test::run_cli("measure no-capture --device p.yaml --roi a.jpg:1,2,30,40 --orientation bogus");
+  const auto r = test::run_cli("measure no-capture --device p.yaml --roi a.jpg:1,2,30,40 --method bogus");
   EXPECT_EQ(r.status, 2);
-  EXPECT_THAT(r.err, HasSubstr("--orientation: bogus not in {"));
+  EXPECT_THAT(r.err, HasSubstr("--method: 'bogus' is not an orientation method, expected ecompass"));
+}
+
+TEST(CliContract, EveryVerbTakesItsOrientationMethodAsMethod) {
+  // measure, calibrate joint, orientation and bench orientation all take --method; each checks
+  // the names while parsing, before reading the capture.
+  for (const char* line :
+       {"measure no-capture --device p.yaml --roi a.jpg:1,2,30,40 --method kalman",
+        "calibrate joint no-capture --method kalman", "orientation no-capture -o o.csv --method kalman",
+        "bench orientation no-capture --method madgwick,kalman"}) {
+    const auto r = test::run_cli(line);
+    EXPECT_EQ(r.status, 2) << line;
+    EXPECT_THAT(r.err, HasSubstr("--method: 'kalman' is not an orientation method")) << line;
+  }
+  // One method where the verb uses one.
+  auto r = test::run_cli("measure no-capture --device p.yaml --roi a.jpg:1,2,30,40 --method madgwick,mahony");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_THAT(r.err, HasSubstr("'madgwick,mahony': one orientation method only"));
+  // Command lines written for the older option names fail with the new name, not with a different meaning.
+  r = test::run_cli("measure no-capture --device p.yaml --roi a.jpg:1,2,30,40 --orientation madgwick");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_THAT(r.err, HasSubstr("--orientation: this option is now called --method (given 'madgwick')"));
+  r = test::run_cli("bench orientation no-capture --methods madgwick");
+  EXPECT_THAT(r.err, HasSubstr("--methods: this option is now called --method"));
+  r = test::run_cli("calibrate joint no-capture --method reference-free");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_THAT(r.err, HasSubstr("'reference-free' is not an orientation method: the calibration solver is --solver"));
 }
 
 TEST(CliContract, JsonToStandardOutputIsAloneThere) {

@@ -55,7 +55,7 @@ TEST(JointCalibrationAcceptance, SimulatedCapturesThroughTheCommandLine) {
     const auto json = dir / fmt::format("joint-{}.json", seed);
     // The simulator's gyroscope samples are instantaneous rates (gyro_trapezoid).
     const auto r =
-        test::run_cli(fmt::format("calibrate joint {} {} --orientation antpose,antpose-smoother "
+        test::run_cli(fmt::format("calibrate joint {} {} --method antpose,antpose-smoother "
                                   "--param gyro_trapezoid=1 --json '{}'",
                                   d("joint"), dev, json.string()));
     ASSERT_EQ(r.status, 0) << r.err << r.out;

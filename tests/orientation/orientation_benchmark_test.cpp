@@ -182,12 +182,12 @@ TEST(OrientationCli, OrientationAndBench) {
 
   r = test::run_cli(fmt::format("orientation {} --method kalman -o {}", capture.string(), (dir / "x.csv").string()));
   EXPECT_EQ(r.status, 2);
-  EXPECT_THAT(r.err, HasSubstr("unknown orientation method 'kalman'"));
+  EXPECT_THAT(r.err, HasSubstr("'kalman' is not an orientation method, expected ecompass"));
   r = test::run_cli(fmt::format("orientation {} --param beta -o {}", capture.string(), (dir / "x.csv").string()));
   EXPECT_EQ(r.status, 2);
   EXPECT_THAT(r.err, HasSubstr("'beta' is not name=value"));
 
-  r = test::run_cli(fmt::format("bench orientation {} --methods madgwick-broad,mahony --json {}", capture.string(),
+  r = test::run_cli(fmt::format("bench orientation {} --method madgwick-broad,mahony --json {}", capture.string(),
                                 (dir / "b.json").string()));
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_THAT(r.out, HasSubstr("1.4968"));

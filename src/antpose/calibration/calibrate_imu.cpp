@@ -14,7 +14,7 @@ namespace fs = std::filesystem;
 Method parse_method(const std::string& text) {
   if (text == "thesis") return Method::kThesis;
   if (text == "full") return Method::kFull;
-  throw InputError({}, fmt::format("--method: '{}' is not a calibration method; expected 'thesis' or 'full'", text));
+  throw InputError({}, fmt::format("'{}' is not an IMU error model; expected 'thesis' or 'full'", text));
 }
 
 void parse_sensors(const std::string& list, CalibrateImuOptions& o) {
