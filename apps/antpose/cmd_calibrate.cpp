@@ -107,10 +107,8 @@ void run_allan(const AllanArgs& args, const CLI::App& verb) {
   const Stream& stream = capture.require(args.stream);
   const auto a = calibration::allan_of_stream(stream, diagnostics, args.capture, args.per_decade);
   print_warnings(diagnostics);
-  const std::string unit = args.stream == streams::kGyroscope       ? "rad/s"
-                           : args.stream == streams::kAccelerometer ? "m/s²"
-                           : args.stream == streams::kMagnetometer  ? "µT"
-                                                                    : "unit";
+  const std::string_view known_unit = streams::unit_of(args.stream);
+  const std::string unit = known_unit.empty() ? "unit" : std::string(known_unit);
   fmt::print("overlapping Allan deviation of '{}' ({} samples, tau0 {:.5f} s, {:.0f} s), unit {}\n", args.stream,
              stream.size(), a.tau0, stream.duration(), unit);
   fmt::print("{:<6} {:>14} {:>14} {:>10} {:>14}\n", "axis", "N (·√s)", "B", "tau_B s", "K (/√s)");

@@ -29,18 +29,19 @@ struct CameraArgs {
 nlohmann::json to_json(const camera::CameraCalibrationResult& r) {
   nlohmann::json j;
   const auto& in = r.intrinsics;
-  j["image_width"] = in.width;
-  j["image_height"] = in.height;
-  j["fx"] = in.fx;
-  j["fy"] = in.fy;
-  j["cx"] = in.cx;
-  j["cy"] = in.cy;
-  j["distortion"] = in.distortion;
+  j["image_width_px"] = in.width;
+  j["image_height_px"] = in.height;
+  j["fx_px"] = in.fx;
+  j["fy_px"] = in.fy;
+  j["cx_px"] = in.cx;
+  j["cy_px"] = in.cy;
+  j["distortion"] = in.distortion;  // OpenCV's coefficients, unitless
   j["rms_px"] = r.rms_px;
-  j["sigma"] = {{"fx", r.sigma.fx},
-                {"fy", r.sigma.fy},
-                {"cx", r.sigma.cx},
-                {"cy", r.sigma.cy},
+  // 1σ of each value, under the value's own key.
+  j["sigma"] = {{"fx_px", r.sigma.fx},
+                {"fy_px", r.sigma.fy},
+                {"cx_px", r.sigma.cx},
+                {"cy_px", r.sigma.cy},
                 {"distortion", r.sigma.distortion}};
   j["flags"] = r.flags;
   j["flag_names"] = r.flag_names;

@@ -85,8 +85,8 @@ void run_wmm(const WmmOptions& o, const CLI::App& verb) {
   if (!o.json.empty()) {
     nlohmann::json j;
     j["model"] = {{"name", model.name()},
-                  {"epoch", model.epoch()},
-                  {"valid_until", model.valid_until()},
+                  {"epoch_year", model.epoch()},
+                  {"valid_until_year", model.valid_until()},
                   {"source", o.cof.empty() ? std::string("built in") : o.cof}};
     j["site"] = {{"lat_deg", lat}, {"lon_deg", lon}, {"alt_km", alt_km}, {"date", date}, {"decimal_year", year}};
     j["valid_date"] = model.valid_for(year);

@@ -31,7 +31,7 @@ TEST(CalibrateCameraCli, WritesCameraYamlJsonAndPrintsTheTable) {
   const CameraFile c = read_camera_file(out);
   EXPECT_NEAR(c.intrinsics.fx, 536.0734168, 1e-4);
   const auto j = nlohmann::json::parse(io::read_text(json));
-  EXPECT_NEAR(j["cy"].get<double>(), 235.5368585, 1e-4);
+  EXPECT_NEAR(j["cy_px"].get<double>(), 235.5368585, 1e-4);
   EXPECT_EQ(j["images"].size(), 13u);
 
   // Existing output: refused without --force (exit 2, before the run), replaced with it.

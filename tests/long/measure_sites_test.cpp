@@ -157,8 +157,9 @@ Row row_of(int antenna, const nlohmann::json& m, const YAML::Node& truth) {
       rad2deg(wrap_pi(deg2rad(m["azimuth_magnetic_deg"].get<double>() - truth["azimuth_magnetic_deg"].as<double>())));
   r.tilt = m["downtilt_deg"].get<double>() - truth["downtilt_deg"].as<double>();
   r.roll = m["roll_deg"].get<double>() - truth["roll_deg"].as<double>();
-  const auto& s = m["uncertainty_deg"];
-  r.s_az = s["azimuth"].get<double>(), r.s_tilt = s["downtilt"].get<double>(), r.s_roll = s["roll"].get<double>();
+  const auto& s = m["sigma"];
+  r.s_az = s["azimuth_magnetic_deg"].get<double>(), r.s_tilt = s["downtilt_deg"].get<double>(),
+  r.s_roll = s["roll_deg"].get<double>();
   for (const auto& w : m["warnings"]) r.warnings += w.get<std::string>() + "; ";
   r.verdict = m["verdict"].get<std::string>();
   r.warned = !r.warnings.empty();

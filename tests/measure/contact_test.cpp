@@ -216,17 +216,18 @@ TEST(Contact, BadInputs) {
 TEST(Contact, JsonHasTheDocumentedKeys) {
   const auto j = to_json(measure_contact(contact_capture(45.0, 6.0, -2.0, ContactPlacement::kTopUp, sim::PhoneModel::ideal())));
   for (const char* key : {"azimuth_magnetic_deg", "azimuth_true_deg", "declination_deg", "downtilt_deg", "roll_deg",
-                          "uncertainty_deg", "warnings", "window_s", "field", "placement", "phone_ypr_deg"})
+                          "sigma", "warnings", "window_s", "field", "placement", "phone_attitude"})
     EXPECT_TRUE(j.contains(key)) << key;
   EXPECT_NEAR(j["azimuth_true_deg"].get<double>(), 45.0, 0.01);
   EXPECT_NEAR(j["downtilt_deg"].get<double>(), 6.0, 0.01);
   EXPECT_NEAR(j["roll_deg"].get<double>(), -2.0, 0.01);
-  for (const char* key : {"azimuth", "downtilt", "roll"}) EXPECT_GT(j["uncertainty_deg"][key].get<double>(), 0.0);
+  for (const char* key : {"azimuth_magnetic_deg", "downtilt_deg", "roll_deg"})
+    EXPECT_GT(j["sigma"][key].get<double>(), 0.0);
   for (const char* key : {"measured_uT", "expected_uT", "dip_deg", "expected_dip_deg"}) EXPECT_TRUE(j["field"][key].is_number());
   EXPECT_EQ(j["placement"], "top-up");
   EXPECT_EQ(j["window_s"].size(), 2u);
   // Top up: pitch = −asin(up component of device y = z_a) = −(90° − acos(cos 6° cos 2°)).
-  EXPECT_NEAR(j["phone_ypr_deg"]["pitch"].get<double>(),
+  EXPECT_NEAR(j["phone_attitude"]["pitch_deg"].get<double>(),
               -(90.0 - rad2deg(std::acos(std::cos(deg2rad(6.0)) * std::cos(deg2rad(2.0))))), 1e-3);
 }
 
@@ -245,7 +246,7 @@ TEST(ContactCli, WritesJsonAndPrintsTable) {
   EXPECT_THAT(res.out, HasSubstr("field check"));
   const auto j = nlohmann::json::parse(io::read_text(dir / "out.json"));
   for (const char* key : {"azimuth_magnetic_deg", "azimuth_true_deg", "declination_deg", "downtilt_deg", "roll_deg",
-                          "uncertainty_deg", "warnings", "window_s", "field", "placement", "phone_ypr_deg"})
+                          "sigma", "warnings", "window_s", "field", "placement", "phone_attitude"})
     EXPECT_TRUE(j.contains(key)) << key;
   // The typical phone has a 10 mg accelerometer bias (≈ 0.6°) uncalibrated.
   EXPECT_NEAR(j["downtilt_deg"].get<double>(), 6.0, 1.0);

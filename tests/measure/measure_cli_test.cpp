@@ -118,15 +118,15 @@ TEST_F(MeasureCli, TheBenchmarkScoresWhatMeasureAnswers) {
   EXPECT_NEAR(scored["azimuth_error_deg"].get<double>(), std::remainder(azimuth, 360.0), 1e-6);
   EXPECT_NEAR(scored["downtilt_error_deg"].get<double>(),
               answer["downtilt_deg"].get<double>() - truth["downtilt_deg"].as<double>(), 1e-6);
-  EXPECT_NEAR(scored["azimuth_sigma_deg"].get<double>(), answer["uncertainty_deg"]["azimuth"].get<double>(), 1e-6);
+  EXPECT_NEAR(scored["azimuth_sigma_deg"].get<double>(), answer["sigma"]["azimuth_magnetic_deg"].get<double>(), 1e-6);
   // The σ's budget: one share per source, their squares adding up to each angle's σ².
-  const auto& budget = answer["uncertainty_budget_deg"];
+  const auto& budget = answer["sigma_budget"];
   ASSERT_GE(budget.size(), 3u) << budget;
   EXPECT_EQ(budget[0]["source"], "board attitude in the world");
-  for (const char* angle : {"azimuth", "downtilt", "roll"}) {
+  for (const char* angle : {"azimuth_magnetic_deg", "downtilt_deg", "roll_deg"}) {
     double sum = 0.0;
     for (const auto& share : budget) sum += std::pow(share[angle].get<double>(), 2);
-    EXPECT_NEAR(std::sqrt(sum), answer["uncertainty_deg"][angle].get<double>(), 1e-6) << angle << " in " << budget;
+    EXPECT_NEAR(std::sqrt(sum), answer["sigma"][angle].get<double>(), 1e-6) << angle << " in " << budget;
   }
 }
 

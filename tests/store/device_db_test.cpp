@@ -150,7 +150,7 @@ TEST(DeviceDb, ImportExportAndMissingIds) {
   EXPECT_EQ(h[0].kind, "import");
   ASSERT_EQ(h[0].inputs.size(), 1u);
   EXPECT_EQ(h[0].inputs[0]["sha256"], sha256_file(dir / "p.yaml"));
-  EXPECT_EQ(h[0].inputs[0]["size"].get<std::uintmax_t>(), fs::file_size(dir / "p.yaml"));
+  EXPECT_EQ(h[0].inputs[0]["size_bytes"].get<std::uintmax_t>(), fs::file_size(dir / "p.yaml"));
   EXPECT_EQ(db.profile("cam1").model, "Fairphone 5");
   EXPECT_FALSE(db.list_devices()[0].last_calibration_utc);  // an import is not a calibration
   EXPECT_EQ(db.list_devices()[0].calibrated, (std::vector<std::string>{"imu", "camera"}));

@@ -55,6 +55,14 @@ namespace streams {
 inline constexpr std::string_view kAccelerometer = "accelerometer";
 inline constexpr std::string_view kGyroscope = "gyroscope";
 inline constexpr std::string_view kMagnetometer = "magnetometer";
+/// The unit of a stream's x, y, z values (capture-format.md §1); empty where the format does not
+/// fix one (other streams).
+constexpr std::string_view unit_of(std::string_view stream) {
+  if (stream == kAccelerometer || stream == "gravity" || stream == "linear_acceleration") return "m/s^2";
+  if (stream == kGyroscope) return "rad/s";
+  if (stream == kMagnetometer) return "uT";
+  return {};
+}
 }  // namespace streams
 
 struct Site {

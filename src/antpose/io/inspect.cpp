@@ -141,22 +141,25 @@ nlohmann::json to_json(const CaptureSummary& s) {
   for (const auto& st : s.streams) {
     nlohmann::json js = {{"name", st.name},
                          {"samples", st.samples},
-                         {"t_first", st.t_first},
-                         {"t_last", st.t_last},
+                         {"t_first_s", st.t_first},
+                         {"t_last_s", st.t_last},
                          {"duration_s", st.duration_s},
                          {"mean_rate_hz", st.mean_rate_hz},
                          {"median_interval_s", st.median_interval_s},
                          {"interval_std_s", st.interval_std_s},
                          {"gaps", st.gaps},
                          {"largest_gap_s", st.largest_gap_s}};
+    // The statistics below are in the stream's unit (null where the format fixes none).
+    const std::string_view unit = streams::unit_of(st.name);
+    js["unit"] = unit.empty() ? nlohmann::json(nullptr) : nlohmann::json(std::string(unit));
     if (st.median_norm) js["median_norm"] = *st.median_norm;
     for (const auto& c : st.columns)
       js["columns"][c.column] = {{"mean", c.mean}, {"std", c.std}, {"min", c.min}, {"max", c.max}};
     j["streams"].push_back(js);
   }
   j["shots"] = {{"count", s.shots.count},
-                {"t_first", s.shots.t_first},
-                {"t_last", s.shots.t_last},
+                {"t_first_s", s.shots.t_first},
+                {"t_last_s", s.shots.t_last},
                 {"outside_sensor_span", s.shots.outside_sensor_span}};
   j["truth"] = {{"present", s.has_truth}, {"world", s.truth_world}, {"samples", s.truth_samples}};
   j["other_files"] = s.other_files;

@@ -205,10 +205,11 @@ nlohmann::json to_json(const ContactResult& r) {
   j["declination_deg"] = deg(r.declination);
   j["downtilt_deg"] = rad2deg(r.downtilt);
   j["roll_deg"] = deg(r.roll);
-  j["uncertainty_deg"] = {{"azimuth", rad2deg(r.sigma.azimuth)},
-                          {"azimuth_true", deg(r.sigma.azimuth_true)},
-                          {"downtilt", rad2deg(r.sigma.downtilt)},
-                          {"roll", rad2deg(r.sigma.roll)}};
+  // 1σ of each angle, under the angle's own key.
+  j["sigma"] = {{"azimuth_magnetic_deg", rad2deg(r.sigma.azimuth)},
+                {"azimuth_true_deg", deg(r.sigma.azimuth_true)},
+                {"downtilt_deg", rad2deg(r.sigma.downtilt)},
+                {"roll_deg", rad2deg(r.sigma.roll)}};
   j["warnings"] = r.warnings;
   j["window_s"] = {r.t0, r.t1};
   j["field"] = {{"measured_uT", r.field_uT},
@@ -216,9 +217,9 @@ nlohmann::json to_json(const ContactResult& r) {
                 {"dip_deg", rad2deg(r.dip)},
                 {"expected_dip_deg", deg(r.expected_dip)}};
   j["placement"] = std::string(to_string(r.placement));
-  j["phone_ypr_deg"] = {{"yaw", rad2deg(r.phone.android.azimuth)},
-                        {"pitch", rad2deg(r.phone.android.pitch)},
-                        {"roll", rad2deg(r.phone.android.roll)}};
+  j["phone_attitude"] = {{"yaw_deg", rad2deg(r.phone.android.azimuth)},
+                         {"pitch_deg", rad2deg(r.phone.android.pitch)},
+                         {"roll_deg", rad2deg(r.phone.android.roll)}};
   return j;
 }
 

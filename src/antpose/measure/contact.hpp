@@ -99,9 +99,9 @@ ContactResult measure_contact(const Capture& capture, const ContactOptions& opti
 imu::HardIronEstimate calibrate_from_recording(const Capture& recording, ContactOptions& options);
 
 /// JSON report: azimuth_magnetic_deg, azimuth_true_deg, declination_deg, downtilt_deg,
-/// roll_deg, uncertainty_deg {azimuth, azimuth_true, downtilt, roll}, warnings, window_s,
-/// field {measured_uT, expected_uT, dip_deg, expected_dip_deg}, placement,
-/// phone_ypr_deg {yaw, pitch, roll}. Undefined values are null.
+/// roll_deg, sigma {azimuth_magnetic_deg, azimuth_true_deg, downtilt_deg, roll_deg}, warnings,
+/// window_s, field {measured_uT, expected_uT, dip_deg, expected_dip_deg}, placement,
+/// phone_attitude {yaw_deg, pitch_deg, roll_deg}. Undefined values are null.
 nlohmann::json to_json(const ContactResult& result);
 
 }  // namespace antpose::measure

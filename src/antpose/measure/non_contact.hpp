@@ -112,9 +112,9 @@ std::vector<std::optional<reconstruction::Mast>> front_back_masts(const std::vec
                                                                   const NonContactSetup& setup, double reach_m);
 
 /// The JSON of the command (docs/non-contact.md): per antenna azimuth_magnetic_deg,
-/// azimuth_true_deg (null without a site), downtilt_deg, roll_deg, uncertainty_deg {azimuth,
-/// downtilt, roll} and its budget by source (uncertainty_budget_deg), verdict, fit_rmse_m,
-/// photos_used, warnings, and more.
+/// azimuth_true_deg (null without a site), downtilt_deg, roll_deg, their 1σ under the same keys
+/// in sigma and its budget by source (sigma_budget), verdict, fit_rmse_m, photos_used, warnings,
+/// and more. Every numeric key carries its unit.
 nlohmann::json to_json(const NonContactResult& result);
 
 }  // namespace antpose::measure

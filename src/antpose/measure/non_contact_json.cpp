@@ -15,9 +15,9 @@ nlohmann::json deg_or_null(const std::optional<double>& rad) {
 
 nlohmann::json comparison_json(const std::optional<registration::Comparison>& c) {
   if (!c) return nullptr;
-  return {{"difference", c->difference},
-          {"standard_error", c->standard_error},
-          {"units", c->units},
+  return {{"score_difference", c->difference},
+          {"score_standard_error", c->standard_error},
+          {"paired_units", c->units},
           {"decisive", c->decisive}};
 }
 
@@ -70,10 +70,10 @@ nlohmann::json time_offset_json(const TimeOffsetCheck& t) {
 nlohmann::json antenna_json(const AntennaMeasurement& m) {
   nlohmann::json a;
   a["roi"] = {{"image", m.roi.image},
-              {"x", m.roi.roi.x},
-              {"y", m.roi.roi.y},
-              {"width", m.roi.roi.width},
-              {"height", m.roi.roi.height}};
+              {"x_px", m.roi.roi.x},
+              {"y_px", m.roi.roi.y},
+              {"width_px", m.roi.roi.width},
+              {"height_px", m.roi.roi.height}};
   a["error"] = m.error ? nlohmann::json(*m.error) : nlohmann::json(nullptr);
   const bool ok = !m.error;
   const auto& at = m.attitude;
@@ -83,18 +83,19 @@ nlohmann::json antenna_json(const AntennaMeasurement& m) {
   a["azimuth_true_deg"] = ok ? deg_or_null(at.azimuth_true) : nullptr;
   a["downtilt_deg"] = ok ? nlohmann::json(rad2deg(at.magnetic.downtilt)) : nullptr;
   a["roll_deg"] = ok ? deg_or_null(at.magnetic.roll) : nullptr;
-  a["uncertainty_deg"] = {{"azimuth", ok ? deg_or_null(at.sigma.azimuth) : nullptr},
-                          {"azimuth_true", ok ? deg_or_null(at.azimuth_true_sigma) : nullptr},
-                          {"downtilt", ok ? nlohmann::json(rad2deg(at.sigma.downtilt)) : nullptr},
-                          {"roll", ok ? deg_or_null(at.sigma.roll) : nullptr}};
+  // 1σ of each angle, under the angle's own key.
+  a["sigma"] = {{"azimuth_magnetic_deg", ok ? deg_or_null(at.sigma.azimuth) : nullptr},
+                {"azimuth_true_deg", ok ? deg_or_null(at.azimuth_true_sigma) : nullptr},
+                {"downtilt_deg", ok ? nlohmann::json(rad2deg(at.sigma.downtilt)) : nullptr},
+                {"roll_deg", ok ? deg_or_null(at.sigma.roll) : nullptr}};
   nlohmann::json budget = nlohmann::json::array();
   if (ok)
     for (const auto& share : at.budget)
       budget.push_back({{"source", share.source},
-                        {"azimuth", deg_or_null(share.sigma.azimuth)},
-                        {"downtilt", rad2deg(share.sigma.downtilt)},
-                        {"roll", deg_or_null(share.sigma.roll)}});
-  a["uncertainty_budget_deg"] = budget;
+                        {"azimuth_magnetic_deg", deg_or_null(share.sigma.azimuth)},
+                        {"downtilt_deg", rad2deg(share.sigma.downtilt)},
+                        {"roll_deg", deg_or_null(share.sigma.roll)}});
+  a["sigma_budget"] = budget;
   a["fit_rmse_m"] = ok ? nlohmann::json(m.fit_rmse_m) : nullptr;
   a["fitness"] = ok ? nlohmann::json(m.fitness) : nullptr;
   nlohmann::json poses = nlohmann::json::array();
@@ -118,7 +119,7 @@ nlohmann::json antenna_json(const AntennaMeasurement& m) {
   for (const auto& e : m.long_edges_left_out)
     long_edges.push_back({{"edge", registration::long_edge_name(e.edge)},
                           {"turn_deg", rad2deg(e.turn_rad)},
-                          {"distance", e.distance},
+                          {"distance_sigma", e.distance},
                           {"disagrees", e.disagrees},
                           {"samples", e.samples},
                           {"whole_samples", e.whole_samples},

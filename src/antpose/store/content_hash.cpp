@@ -69,7 +69,7 @@ std::vector<InputFile> hash_inputs(const fs::path& path) {
 
 nlohmann::json to_json(const std::vector<InputFile>& inputs) {
   nlohmann::json j = nlohmann::json::array();
-  for (const auto& f : inputs) j.push_back({{"path", f.path}, {"sha256", f.sha256}, {"size", f.size}});
+  for (const auto& f : inputs) j.push_back({{"path", f.path}, {"sha256", f.sha256}, {"size_bytes", f.size}});
   return j;
 }
 
