@@ -9,7 +9,7 @@ DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recomme
   build-essential cmake ninja-build pkg-config git \
   libeigen3-dev libceres-dev libopencv-dev libopencv-contrib-dev libnanoflann-dev libtbb-dev \
   libsqlite3-dev libssl-dev libyaml-cpp-dev libcli11-dev nlohmann-json3-dev libfmt-dev \
-  zlib1g-dev libpugixml-dev libgtest-dev libgmock-dev libbenchmark-dev
+  zlib1g-dev libpugixml-dev libexiv2-dev libgtest-dev libgmock-dev libbenchmark-dev
 # A unity build (eight sources per unit) compiles the templates its units share (Eigen, OpenCV,
 # gtest) once per batch: a fresh build takes 41 % less CPU (docs/architecture.md).
 # Incremental work is quicker without it: configure a second folder without the flag.

@@ -372,6 +372,25 @@ TEST(CalibrateCamera, BadPhotosAreReportedAndTheCalibrationContinues) {
   EXPECT_EQ(static_cast<std::string>(rejected_node[2]["reason"]), rejected[2].second);
 }
 
+TEST(CalibrateCamera, OnePhotoClaimingAnotherSizeIsRefusedAloneEvenWhenFirst) {
+  test::TempDir dir;
+  const fs::path root = capture_with_bad_photos(dir, 13);
+  // The first photo listed claims 1280×960 px in its header (the photos' aspect ratio): the size
+  // most photos share decides, not the first.
+  test::write_file(root / "images/claim.jpg", test::jpeg_claiming(1280, 960));
+  test::write_file(root / "shots.csv",
+                   "index,t,image\n99,0,images/claim.jpg\n" +
+                       io::read_text(root / "shots.csv").substr(std::string("index,t,image\n").size()));
+  Diagnostics diagnostics;
+  const auto r = calibrate_camera(root, CalibrationSettings{}, diagnostics);
+  EXPECT_EQ(r.used_count(), 13u);
+  const auto rejected = r.rejected();
+  ASSERT_EQ(rejected.size(), 5u);
+  EXPECT_EQ(rejected[0].first, "images/claim.jpg");
+  EXPECT_EQ(rejected[0].second, "image is 1280x960 px, most photos are 640x480 px (one camera mode per calibration)");
+  EXPECT_NEAR(r.intrinsics.fx, test_data::reference("opencv-chessboard-9x6", "measured_default").fx, 1e-6);
+}
+
 TEST(CalibrateCamera, TooFewGoodPhotosIsAMeasurementError) {
   test::TempDir dir;
   const fs::path root = capture_with_bad_photos(dir, 2);

@@ -15,18 +15,7 @@ namespace {
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 
-// A valid 64×48 JPEG whose frame header (SOF0) claims `width`×`height`.
-std::string jpeg_claiming(int width, int height) {
-  std::vector<uchar> bytes;
-  cv::imencode(".jpg", cv::Mat(48, 64, CV_8UC1, cv::Scalar(100)), bytes);
-  for (std::size_t i = 0; i + 8 < bytes.size(); ++i)
-    if (bytes[i] == 0xFF && bytes[i + 1] == 0xC0) {  // length(2) precision(1) height(2) width(2)
-      bytes[i + 5] = static_cast<uchar>(height >> 8), bytes[i + 6] = static_cast<uchar>(height & 0xFF);
-      bytes[i + 7] = static_cast<uchar>(width >> 8), bytes[i + 8] = static_cast<uchar>(width & 0xFF);
-      break;
-    }
-  return std::string(bytes.begin(), bytes.end());
-}
+using test::jpeg_claiming;
 
 TEST(PhotoFile, APhotoDecodesAndABadOneGivesItsReason) {
   test::TempDir dir;
@@ -48,6 +37,33 @@ TEST(PhotoFile, APhotoDecodesAndABadOneGivesItsReason) {
   fs::create_directories(dir / "folder.jpg");
   EXPECT_EQ(read_photo(dir / "folder.jpg", cv::IMREAD_GRAYSCALE).problem, "is a folder, expected a file");
   EXPECT_EQ(read_photo(dir / "none.jpg", cv::IMREAD_GRAYSCALE).problem, "file not found");
+}
+
+TEST(PhotoFile, AHeaderGivesTheSizeItClaimsWithoutDecoding) {
+  test::TempDir dir;
+  test::write_file(dir / "good.jpg", jpeg_claiming(64, 48));
+  const PhotoHeader good = read_photo_header(dir / "good.jpg");
+  ASSERT_TRUE(good.ok()) << good.problem;
+  EXPECT_EQ(good.width_px, 64);
+  EXPECT_EQ(good.height_px, 48);
+  // The claim, not the truth: decoding would need 900 MB.
+  const PhotoHeader claim = read_photo_header(dir / "claim.jpg");
+  EXPECT_EQ(claim.problem, "file not found");
+  test::write_file(dir / "claim.jpg", jpeg_claiming(30000, 30000));
+  const PhotoHeader huge = read_photo_header(dir / "claim.jpg");
+  ASSERT_TRUE(huge.ok()) << huge.problem;
+  EXPECT_EQ(huge.width_px, 30000);
+  std::vector<uchar> png;
+  cv::imencode(".png", cv::Mat(7, 5, CV_8UC3, cv::Scalar(1, 2, 3)), png);
+  test::write_file(dir / "small.png", std::string(png.begin(), png.end()));
+  const PhotoHeader small = read_photo_header(dir / "small.png");
+  EXPECT_EQ(small.width_px, 5);
+  EXPECT_EQ(small.height_px, 7);
+
+  test::write_file(dir / "text.jpg", "not a photo");
+  EXPECT_THAT(read_photo_header(dir / "text.jpg").problem, HasSubstr("its header cannot be read ("));
+  fs::create_directories(dir / "folder.jpg");
+  EXPECT_EQ(read_photo_header(dir / "folder.jpg").problem, "is a folder, expected a file");
 }
 
 }  // namespace

@@ -221,6 +221,24 @@ TEST_F(MeasureCli, PhotosWithoutTheBoardAreNamedAndLeftOut) {
   EXPECT_THAT(one.err, HasSubstr("the board was found in 1 of 6 photos; at least 2 are needed"));
 }
 
+TEST_F(MeasureCli, OnePhotoWhoseHeaderClaimsAnotherSizeIsRefusedAlone) {
+  const auto cap = copy("huge-header");
+  // The first photo (not the ROI's) becomes a small JPEG whose header claims 28800×21600 px: the
+  // photos' aspect ratio, so that taken for the capture's size it would rescale the intrinsics and
+  // every other photo would be refused.
+  const std::string victim = roi_image_ == "images/img_0000.jpg" ? "images/img_0001.jpg" : "images/img_0000.jpg";
+  test::write_file(cap / victim, test::jpeg_claiming(28800, 21600));
+  const auto json = *dir_ / "huge-header.json";
+  const auto r =
+      test::run_cli(measure(cap, fmt::format("--model {} --roi {} --json '{}'", model_, roi_, json.string())));
+  ASSERT_THAT(r.status, AnyOf(0, 4)) << r.err;
+  EXPECT_THAT(r.err, HasSubstr(victim + ": photo skipped: image is 28800x21600 px but the intrinsics are for 960x720"));
+  const auto j = nlohmann::json::parse(io::read_text(json));
+  EXPECT_EQ(j["photos_with_board"], 5);
+  EXPECT_EQ(j["photo_size_px"], nlohmann::json::array({960, 720}));
+  EXPECT_TRUE(j["antennas"][0]["error"].is_null()) << j["antennas"][0]["error"];
+}
+
 TEST_F(MeasureCli, PhotosAllFromOnePlaceGiveNoConfidentNumber) {
   const auto cap = copy("one-place");
   // Every shot is the ROI's photo at (nearly) its instant: one viewpoint, no baseline.

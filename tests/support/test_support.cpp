@@ -11,6 +11,7 @@
 #include <stdexcept>
 
 #include <fmt/format.h>
+#include <opencv2/imgcodecs.hpp>
 
 namespace antpose::test {
 namespace fs = std::filesystem;
@@ -77,6 +78,18 @@ CliResult run_cli(const std::string& args) { return run_command("", args); }
 CliResult run_cli_unprivileged(const std::string& args) {
   // The output files are created by the shell before setpriv drops the privilege.
   return run_command(::geteuid() == 0 ? "setpriv --reuid=65534 --regid=65534 --clear-groups -- " : "", args);
+}
+
+std::string jpeg_claiming(int width, int height) {
+  std::vector<uchar> bytes;
+  cv::imencode(".jpg", cv::Mat(48, 64, CV_8UC1, cv::Scalar(100)), bytes);
+  for (std::size_t i = 0; i + 8 < bytes.size(); ++i)
+    if (bytes[i] == 0xFF && bytes[i + 1] == 0xC0) {  // length(2) precision(1) height(2) width(2)
+      bytes[i + 5] = static_cast<uchar>(height >> 8), bytes[i + 6] = static_cast<uchar>(height & 0xFF);
+      bytes[i + 7] = static_cast<uchar>(width >> 8), bytes[i + 8] = static_cast<uchar>(width & 0xFF);
+      break;
+    }
+  return std::string(bytes.begin(), bytes.end());
 }
 
 }  // namespace antpose::test

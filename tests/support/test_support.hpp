@@ -38,6 +38,9 @@ class TempDir {
 /// Writes a text file (creating folders).
 void write_file(const std::filesystem::path& file, std::string_view content);
 
+/// A valid 64×48 grey JPEG whose frame header (SOF0) claims `width`×`height` px.
+std::string jpeg_claiming(int width, int height);
+
 struct CliResult {
   int status = 0;
   std::string out;  // stdout

@@ -142,6 +142,51 @@ std::vector<PhotoBoardPose> board_poses(const Capture& capture, const BoardSpec&
   return board_poses(capture, board, intrinsics, diagnostics, DetectionOptions{});
 }
 
+namespace {
+
+// Why a decoded photo cannot serve, or empty.
+std::string decoded_photo_refusal(const io::Photo& photo, const CameraIntrinsics& in) {
+  if (!photo.ok()) return photo.problem;
+  if (photo.image.depth() != CV_8U) return "unsupported image (not 8 bits per channel)";
+  return image_size_mismatch(photo.image.cols, photo.image.rows, in);
+}
+
+// The board's pose in one photo, or why there is none; `notes` gets the photo's warnings.
+PhotoBoardPose board_pose_in_photo(const Capture& capture, std::size_t i, const BoardSpec& board,
+                                   const DetectionOptions& options, std::vector<std::string>& notes) {
+  const Shot& shot = capture.shots[i];
+  PhotoBoardPose p{i, shot.t, shot.image, std::nullopt, {}, shot.extra, {}, {}};
+  const auto file = capture.root / shot.image;
+  // A header that claims another size is refused before its pixels are decoded (a false claim of
+  // 30000×30000 px would otherwise be decoded into 900 MB).
+  if (const io::PhotoHeader header = io::read_photo_header(file); header.ok())
+    p.reason = image_size_mismatch(header.width_px, header.height_px, *options.intrinsics);
+  io::Photo photo;
+  if (p.reason.empty()) {
+    photo = io::read_photo(file, cv::IMREAD_UNCHANGED);
+    p.reason = decoded_photo_refusal(photo, *options.intrinsics);
+  }
+  if (p.reason.empty()) {
+    const BoardDetection d = detect_board(photo.image, board, options);
+    if (!d.found) {
+      p.reason = d.reason;
+    } else {
+      if (!d.reason.empty()) notes.push_back(d.reason);
+      try {
+        p.pose = estimate_board_pose(d.image_points, d.object_points, *options.intrinsics);
+        p.image_points_px = d.image_points;
+        p.board_points_m = d.object_points;
+      } catch (const MeasurementError& e) {
+        p.reason = e.what();
+      }
+    }
+  }
+  if (!p.reason.empty()) notes.push_back("photo skipped: " + p.reason);
+  return p;
+}
+
+}  // namespace
+
 std::vector<PhotoBoardPose> board_poses(const Capture& capture, const BoardSpec& board,
                                         const CameraIntrinsics& intrinsics, Diagnostics& diagnostics,
                                         const DetectionOptions& options_in) {
@@ -151,34 +196,8 @@ std::vector<PhotoBoardPose> board_poses(const Capture& capture, const BoardSpec&
   // Photos are independent: detected in parallel, their warnings then given in shot order.
   std::vector<PhotoBoardPose> out(capture.shots.size());
   std::vector<std::vector<std::string>> notes(capture.shots.size());
-  tbb::parallel_for(std::size_t{0}, capture.shots.size(), [&](std::size_t i) {
-    const Shot& shot = capture.shots[i];
-    PhotoBoardPose p{i, shot.t, shot.image, std::nullopt, {}, shot.extra, {}, {}};
-    const auto file = capture.root / shot.image;
-    const io::Photo photo = io::read_photo(file, cv::IMREAD_UNCHANGED);
-    const cv::Mat& image = photo.image;
-    if (!photo.ok() || image.depth() != CV_8U) {
-      p.reason = !photo.ok() ? photo.problem : "unsupported image (not 8 bits per channel)";
-    } else if (const auto mismatch = image_size_mismatch(image.cols, image.rows, intrinsics); !mismatch.empty()) {
-      p.reason = mismatch;
-    } else {
-      const BoardDetection d = detect_board(image, board, options);
-      if (!d.found) {
-        p.reason = d.reason;
-      } else {
-        if (!d.reason.empty()) notes[i].push_back(d.reason);
-        try {
-          p.pose = estimate_board_pose(d.image_points, d.object_points, intrinsics);
-          p.image_points_px = d.image_points;
-          p.board_points_m = d.object_points;
-        } catch (const MeasurementError& e) {
-          p.reason = e.what();
-        }
-      }
-    }
-    if (!p.reason.empty()) notes[i].push_back("photo skipped: " + p.reason);
-    out[i] = std::move(p);
-  });
+  tbb::parallel_for(std::size_t{0}, capture.shots.size(),
+                    [&](std::size_t i) { out[i] = board_pose_in_photo(capture, i, board, options, notes[i]); });
   for (std::size_t i = 0; i < out.size(); ++i)
     for (auto& n : notes[i]) diagnostics.warn(capture.root / capture.shots[i].image, 0, std::move(n));
   return out;

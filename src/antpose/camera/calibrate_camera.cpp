@@ -577,11 +577,15 @@ CameraCalibrationResult calibrate_camera(const Capture& capture, const Calibrati
   // One detection pass over all photos; warnings and progress only when asked (final pass).
   std::vector<CalibrationView> views;
   std::vector<CalibrationImage> images;
+  // One camera mode per calibration: the size most photos' headers give (else the first decoded).
+  const std::optional<cv::Size> common_size = io::common_photo_size(capture);
   int width = 0, height = 0;
   auto detect_all = [&](const DetectionOptions& options, Diagnostics* warn, const CalibrationProgress* report) {
     views.clear();
     images.clear();
-    width = height = 0;
+    width = common_size ? common_size->width : 0;
+    height = common_size ? common_size->height : 0;
+    bool any_read = false;
     for (std::size_t i = 0; i < capture.shots.size(); ++i) {
       const Shot& shot = capture.shots[i];
       const fs::path file = capture.root / shot.image;
@@ -590,19 +594,25 @@ CameraCalibrationResult calibrate_camera(const Capture& capture, const Calibrati
       im.image = shot.image;
       CalibrationView view;
       view.name = shot.image;
-      io::Photo photo = io::read_photo(file, cv::IMREAD_UNCHANGED);
+      const io::PhotoHeader header = io::read_photo_header(file);
+      const bool other_size = common_size && header.ok() && cv::Size(header.width_px, header.height_px) != *common_size;
+      io::Photo photo = other_size ? io::Photo{} : io::read_photo(file, cv::IMREAD_UNCHANGED);
       cv::Mat image = std::move(photo.image);
-      if (!photo.ok()) {
+      if (other_size) {
+        im.reason = fmt::format("image is {}x{} px, most photos are {}x{} px (one camera mode per calibration)",
+                                header.width_px, header.height_px, width, height);
+      } else if (!photo.ok()) {
         im.reason = photo.problem;
       } else if (image.depth() != CV_8U) {
         im.reason = "unsupported image (not 8 bits per channel)";
       } else {
+        any_read = true;
         if (width == 0) {
           width = image.cols;
           height = image.rows;
         }
         if (image.cols != width || image.rows != height) {
-          im.reason = fmt::format("image is {}x{} px, the first photo is {}x{} px (one camera mode per calibration)",
+          im.reason = fmt::format("image is {}x{} px, most photos are {}x{} px (one camera mode per calibration)",
                                   image.cols, image.rows, width, height);
         } else {
           if (s.flip_vertical) cv::flip(image, image, 0);
@@ -621,7 +631,7 @@ CameraCalibrationResult calibrate_camera(const Capture& capture, const Calibrati
       views.push_back(std::move(view));
       images.push_back(std::move(im));
     }
-    if (width == 0)
+    if (!any_read)
       throw MeasurementError(fmt::format("camera calibration: none of the {} photos could be read{}", images.size(),
                                          list_reasons(images)));
   };

@@ -1,7 +1,11 @@
 #include "antpose/io/photo_file.hpp"
 
+#include <algorithm>
+#include <exception>
+#include <mutex>
 #include <new>
 
+#include <exiv2/exiv2.hpp>
 #include <opencv2/imgcodecs.hpp>
 
 #include "antpose/core/error.hpp"
@@ -25,6 +29,56 @@ Photo read_photo(const std::filesystem::path& file, int flags) {
   }
   if (!photo.ok()) photo.image.release();
   return photo;
+}
+
+namespace {
+
+// Exiv2 logs a damaged file's details to stderr itself; the caller gets them as the reason.
+// Its XMP parser must be set up once before threads read files (Exiv2::XmpParser::initialize).
+void set_up_exiv2() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    Exiv2::LogMsg::setLevel(Exiv2::LogMsg::mute);
+    Exiv2::XmpParser::initialize();
+  });
+}
+
+}  // namespace
+
+PhotoHeader read_photo_header(const std::filesystem::path& file) {
+  set_up_exiv2();
+  PhotoHeader header;
+  try {
+    require_regular_file(file, kMaxPhotoBytes);
+    auto image = Exiv2::ImageFactory::open(file.string());
+    image->readMetadata();
+    header.width_px = image->pixelWidth();
+    header.height_px = image->pixelHeight();
+    if (header.width_px <= 0 || header.height_px <= 0) header.problem = "its header gives no size";
+  } catch (const InputError& e) {
+    header.problem = e.detail();
+  } catch (const std::exception& e) {  // Exiv2::AnyError: not an image format Exiv2 knows, or damaged
+    header.problem = std::string("its header cannot be read (") + e.what() + ")";
+  }
+  return header;
+}
+
+std::optional<cv::Size> common_photo_size(const Capture& capture) {
+  std::vector<std::pair<cv::Size, std::size_t>> counts;  // in order of first appearance
+  for (const auto& shot : capture.shots) {
+    const auto header = read_photo_header(capture.root / shot.image);
+    if (!header.ok()) continue;
+    const cv::Size size(header.width_px, header.height_px);
+    const auto at = std::find_if(counts.begin(), counts.end(), [&](const auto& c) { return c.first == size; });
+    if (at == counts.end())
+      counts.emplace_back(size, 1);
+    else
+      ++at->second;
+  }
+  if (counts.empty()) return std::nullopt;
+  return std::max_element(counts.begin(), counts.end(),
+                          [](const auto& a, const auto& b) { return a.second < b.second; })
+      ->first;
 }
 
 }  // namespace antpose::io

@@ -3,9 +3,12 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 
 #include <opencv2/core.hpp>
+
+#include "antpose/io/capture.hpp"
 
 namespace antpose::io {
 
@@ -23,5 +26,22 @@ struct Photo {
 /// kMaxPhotoBytes, or that OpenCV refuses (not an image, truncated, a header claiming more
 /// pixels than OpenCV accepts) gives its reason in Photo::problem; it never throws for the file.
 Photo read_photo(const std::filesystem::path& file, int flags);
+
+/// What a photo's header says, read without decoding its pixels (Exiv2).
+struct PhotoHeader {
+  int width_px = 0, height_px = 0;  // as stored, before any EXIF orientation
+  std::string problem;              // as Photo::problem; also a header Exiv2 cannot read
+  bool ok() const { return problem.empty(); }
+};
+
+/// The header of `file`: its stored size, in microseconds where decoding takes a second. The size
+/// is what the file claims; a photo whose claim is false is refused when it is decoded.
+PhotoHeader read_photo_header(const std::filesystem::path& file);
+
+/// The size most of the capture's photos share, from their headers; nullopt where no header can
+/// be read. Ties go to the size of the earlier photo. One file whose header claims another size
+/// (a resized copy, a damaged header) is then refused alone, by the caller's size check, instead
+/// of deciding the size for all.
+std::optional<cv::Size> common_photo_size(const Capture& capture);
 
 }  // namespace antpose::io

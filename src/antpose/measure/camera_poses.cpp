@@ -11,24 +11,21 @@
 namespace antpose::measure {
 namespace {
 
-// The intrinsics of the capture's photos: the calibration's, or rescaled to the size of the first
-// photo that decodes where that is the same sensor at another resolution.
+// The intrinsics of the capture's photos: the calibration's, or rescaled to the photos' common
+// size where that is the same sensor at another resolution.
 camera::CameraIntrinsics photo_intrinsics(const Capture& capture, const camera::CameraIntrinsics& calibrated,
                                           std::vector<std::string>& warnings) {
-  for (const auto& shot : capture.shots) {
-    const cv::Mat image = io::read_photo(capture.root / shot.image, cv::IMREAD_GRAYSCALE).image;
-    if (image.empty()) continue;
-    if (image.cols == calibrated.width && image.rows == calibrated.height) return calibrated;
-    const auto rescaled = camera::rescaled_intrinsics(calibrated, image.cols, image.rows);
-    if (!rescaled) return calibrated;  // each photo then gets the size mismatch as its reason
-    warnings.push_back(fmt::format(
-        "the photos are {}×{} px and the camera was calibrated at {}×{} px: its intrinsics are scaled by {:.4f} "
-        "(the same sensor read at a lower resolution); calibrate at this resolution if the phone crops instead",
-        image.cols, image.rows, calibrated.width, calibrated.height,
-        static_cast<double>(image.cols) / calibrated.width));
-    return *rescaled;
-  }
-  return calibrated;
+  const auto size = io::common_photo_size(capture);
+  if (!size) return calibrated;  // each photo then gets its own reason
+  const int width = size->width, height = size->height;
+  if (width == calibrated.width && height == calibrated.height) return calibrated;
+  const auto rescaled = camera::rescaled_intrinsics(calibrated, width, height);
+  if (!rescaled) return calibrated;  // each photo then gets the size mismatch as its reason
+  warnings.push_back(fmt::format(
+      "the photos are {}×{} px and the camera was calibrated at {}×{} px: its intrinsics are scaled by {:.4f} "
+      "(the same sensor read at a lower resolution); calibrate at this resolution if the phone crops instead",
+      width, height, calibrated.width, calibrated.height, static_cast<double>(width) / calibrated.width));
+  return *rescaled;
 }
 
 }  // namespace
