@@ -239,6 +239,32 @@ TEST_F(MeasureCli, OnePhotoWhoseHeaderClaimsAnotherSizeIsRefusedAlone) {
   EXPECT_TRUE(j["antennas"][0]["error"].is_null()) << j["antennas"][0]["error"];
 }
 
+TEST_F(MeasureCli, AWrongBoardSizeIsNamedWhereTheAntennaFails) {
+  // A copy whose board.yaml gives `factor` times the printed square.
+  const auto scaled = [](const std::string& name, double factor) {
+    const auto cap = copy(name);
+    YAML::Node board = YAML::LoadFile((cap / "board.yaml").string());
+    const double square_m = factor * board["square_m"].as<double>();
+    board["square_m"] = square_m;
+    YAML::Emitter out;
+    out << board;
+    test::write_file(cap / "board.yaml", out.c_str());
+    return std::pair{cap, fmt::format("{} m", square_m)};
+  };
+  // Half: the antenna's points span half the model.
+  const auto [half, half_m] = scaled("half-board", 0.5);
+  auto r = test::run_cli(measure(half, fmt::format("--model {} --roi {}", model_, roi_)));
+  EXPECT_EQ(r.status, 3) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("if the board's square_m (" + half_m + " in board.yaml) or the model's size is wrong"));
+  // Ten times: by the board the phone was carried at a run, whatever the antenna's reason.
+  const auto [tenfold, tenfold_m] = scaled("tenfold-board", 10.0);
+  r = test::run_cli(measure(tenfold, fmt::format("--model {} --roi {}", model_, roi_)));
+  EXPECT_EQ(r.status, 3) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("faster than a person framing photos walks (limit 3.0 m/s): check square_m (" +
+                               tenfold_m + " in board.yaml)"));
+  EXPECT_THAT(r.out, HasSubstr("the board's scale is in doubt (see the warning on square_m)"));
+}
+
 TEST_F(MeasureCli, PhotosAllFromOnePlaceGiveNoConfidentNumber) {
   const auto cap = copy("one-place");
   // Every shot is the ROI's photo at (nearly) its instant: one viewpoint, no baseline.

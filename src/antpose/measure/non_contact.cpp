@@ -51,6 +51,21 @@ Mat3 pose_rotation_covariance(const reconstruction::RefinedPoses& poses) {
   return n ? Mat3(sum / static_cast<double>(n * n)) : Mat3(Mat3::Zero());
 }
 
+// A failed antenna's reason, followed by what says the lengths are wrong: the walk's speed, or
+// its points' extent against the model. The reason itself stays, as the scale is only suspected.
+void name_doubtful_scale(std::vector<AntennaMeasurement>& antennas, const NonContactSetup& setup, const WalkScale& walk,
+                         const ScaleCheckOptions& options) {
+  for (std::size_t k = 0; k < antennas.size(); ++k) {
+    auto& m = antennas[k];
+    if (!m.error) continue;
+    if (walk.warning)
+      *m.error += "; the board's scale is in doubt (see the warning on square_m)";
+    else if (const auto* model = setup.model_for(k))
+      if (const auto hint = model_scale_hint(m.region.cloud_board.points, *model, setup.board, options))
+        *m.error += "; " + *hint;
+  }
+}
+
 // Each antenna alone: its region, its registration, its attitude. An antenna that cannot be
 // measured keeps its reason.
 AntennaMeasurement measure_alone(std::size_t k, std::size_t shot, const NonContactSetup& setup,
@@ -200,6 +215,7 @@ OptionProblems NonContactOptions::Check() const {
   p.nest("poses", poses.Check());
   p.nest("world", world.Check());
   p.nest("antenna", antenna.Check());
+  p.nest("scale", scale.Check());
   p.require(joint_rounds >= 0 && joint_rounds <= 5, "joint_rounds", "0..5");
   p.require(shared_mast_reach_m >= 0, "shared_mast_reach_m", "≥ 0 (0: no mast shared)");
   return p;
@@ -239,11 +255,14 @@ NonContactResult measure_non_contact(const Capture& capture, const NonContactSet
                                setup.board,
                                result.board.R_world_board.transpose() * Vec3::UnitZ(),
                                pose_rotation_covariance(poses.refined)};
+  const WalkScale walk = check_walk_scale(capture, poses, setup.board, options.scale);
+  if (walk.warning) result.warnings.push_back(*walk.warning);
   for (std::size_t k = 0; k < setup.rois.size(); ++k)
     result.antennas.push_back(measure_alone(k, roi_shots[k], setup, context, options));
   measure_jointly(result.antennas, setup, context, options);
   if (options.joint_rounds > 0) settle_front_back(result.antennas, setup, context, options);
   refuse_shared_panels(result.antennas, setup, poses);
+  name_doubtful_scale(result.antennas, setup, walk, options.scale);
   return result;
 }
 

@@ -29,6 +29,7 @@
 #include "antpose/io/capture.hpp"
 #include "antpose/measure/antenna_measurement.hpp"
 #include "antpose/measure/camera_poses.hpp"
+#include "antpose/measure/scale_check.hpp"
 #include "antpose/measure/world_alignment.hpp"
 #include "antpose/model/antenna_model.hpp"
 
@@ -53,6 +54,7 @@ struct NonContactOptions {
   CameraPoseOptions poses;
   WorldAlignmentOptions world;
   AntennaOptions antenna;
+  ScaleCheckOptions scale;
   /// Rounds with the other antennas known (their boxes masked in the photos, their points left
   /// out); 0: each antenna alone.
   int joint_rounds = 1;
