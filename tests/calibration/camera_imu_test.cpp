@@ -1,6 +1,7 @@
 #include "antpose/calibration/camera_imu.hpp"
 
 #include <cmath>
+#include <map>
 #include <cstdio>
 #include <random>
 #include <tuple>
@@ -480,6 +481,34 @@ TEST(CameraImu, StillPhoneMakesTheTimeOffsetUnobservable) {
   EXPECT_TRUE(std::isnan(r.time_offset_sigma_s));
   EXPECT_EQ(r.time_offset_s, 0.0);
   EXPECT_LT(rad2deg(rotation_distance(r.R_device_camera, s.X)), 0.2);
+}
+
+// Fits the model does not describe are refused, not given a σ scaled by the misfit: boards that
+// turned by 8° halfway through every placement (too many photos to be outliers), and a time offset
+// held fixed 15 ms from the true one. (A 2° turn gives χ²/dof ≈ 5: a σ widened by √5, not refused.)
+TEST(CameraImu, AMisfitIsRefusedAndSoIsAFixedOffsetThePhotosContradict) {
+  const Scenario s = make_scenario(ScenarioOptions{});
+  auto moved = s.photos;
+  std::map<std::string, std::size_t> seen;
+  for (auto& p : moved)
+    if (++seen[p.placement] > 6) p.R_camera_board = p.R_camera_board * exp_so3(deg2rad(8.0) * Vec3(0.6, 0.8, 0.0));
+  Diagnostics d;
+  const auto misfit = test::error_message<MeasurementError>(
+      [&] { calibrate_reference_free(moved, s.gyro, s.track, free_options(), d); });
+  EXPECT_THAT(misfit, HasSubstr("times their expected noise (χ²/dof"));
+  EXPECT_THAT(misfit, HasSubstr("a board moved within a placement"));
+
+  auto fixed = free_options();
+  fixed.estimate_time_offset = false;
+  fixed.time_offset_start_s = 0.035 + 0.015;
+  const auto contradicted =
+      test::error_message<MeasurementError>([&] { calibrate_reference_free(s.photos, s.gyro, s.track, fixed, d); });
+  EXPECT_THAT(contradicted,
+              HasSubstr("the time offset held fixed at 50.0 ms contradicts the photos, which put it at 3"));
+  fixed.time_offset_start_s = 0.035;  // the true one is accepted
+  EXPECT_LT(
+      rad2deg(rotation_distance(calibrate_reference_free(s.photos, s.gyro, s.track, fixed, d).R_device_camera, s.X)),
+      0.2);
 }
 
 TEST(CameraImu, DegenerateAndInvalidInputsAreReported) {

@@ -271,5 +271,22 @@ TEST(UncalibratedGyroscopeCli, WidenedSigmaOrRefusalKeepingTheProfile) {
   EXPECT_LE(std::abs(stored->time_offset_s - 0.030), 3.0 * *stored->time_offset_sigma_s);
 }
 
+// A time offset given as fixed is tested against the photos: the true one (30 ms) is accepted; one
+// 20 ms off, which the fit would absorb into R_device_camera with a σ that does not cover it, is
+// refused and the profile keeps its calibration.
+TEST(UncalibratedGyroscopeCli, AFixedTimeOffsetThePhotosContradictIsRefused) {
+  test::TempDir dir;
+  const auto capture = write_real_photo_capture(dir, 0.9, 1.0);
+  const auto device = write_device(dir, "phone.yaml", true);
+  const std::string before = io::read_text(device);
+  const auto wrong = test::run_cli(joint_command(capture, device) + " --fixed-time-offset --time-offset 0.010");
+  EXPECT_EQ(wrong.status, 3) << wrong.err;
+  EXPECT_THAT(wrong.err, HasSubstr("the time offset held fixed at 10.0 ms contradicts the photos, which put it at 3"));
+  EXPECT_THAT(wrong.err, HasSubstr("phone.yaml was not changed"));
+  EXPECT_EQ(io::read_text(device), before);
+  const auto right = test::run_cli(joint_command(capture, device) + " --fixed-time-offset --time-offset 0.030");
+  EXPECT_EQ(right.status, 0) << right.err;
+}
+
 }  // namespace
 }  // namespace antpose::calibration

@@ -177,6 +177,14 @@ struct ReferenceFreeOptions {
   double huber_k = 3.0;                     // Huber threshold on the whitened residual norm
   double outlier_chi2 = 16.27;              // χ²₃(0.999) on the robustly normalised residual
   double min_outlier_deg = 0.1;             // and a residual angle above this (noise-free data)
+  /// χ²/dof of the inliers' whitened residuals (the variance factor) beyond this, the fit is
+  /// refused: residuals five times the photos' expected noise say the model does not describe
+  /// them (a fixed time offset far from the true one, a board moved within a placement), and a
+  /// covariance scaled by such a misfit would still understate the error.
+  double max_variance_factor = 25.0;
+  /// A time offset given as fixed (estimate_time_offset false) that the photos, refitted with it
+  /// free, put further away than this many σ is refused (where the phone moved at the shots).
+  double max_fixed_offset_z = 5.0;
   int max_iterations = 100;
 
   /// The error budget of an uncalibrated phone gyroscope, 1σ: scale 0.5 %, each cross-axis term
@@ -232,8 +240,8 @@ struct ReferenceFreeCalibration {
   bool gyro_correction_estimated = false;
   Mat3 gyro_correction = Mat3::Identity();
   Mat3 gyro_correction_sigma = Mat3::Zero();
-  double variance_factor = 1.0;           // χ²/dof of the whitened residuals (scales covariance;
-                                          // only from above 1 for an uncalibrated gyroscope)
+  double variance_factor = 1.0;           // χ²/dof of the whitened residuals (scales the
+                                          // covariance where above 1)
   std::vector<PhotoResidual> residuals;   // one per photo used (outliers included, flagged)
   std::vector<std::size_t> outliers;      // indexes into the input photos
   std::vector<PlacementAttitude> boards;

@@ -344,6 +344,45 @@ void refuse_offset_blurred_by_gyroscope(const ReferenceFreeCalibration& out, con
       1e3 * out.time_offset_sigma_fit_s, 1e3 * limit));
 }
 
+/// The test of a time offset given as fixed (ReferenceFreeOptions::max_fixed_offset_z): the fit is
+/// repeated with δt free, from the fixed value, and where the photos put δt further from it than
+/// that many σ (σ scaled by the refit's variance factor where above 1), the fixed value is
+/// refused: the rotation fitted under it absorbs the timing error as a bias its σ does not cover.
+void refuse_contradicted_offset(const FreeProblem& fp, const std::vector<bool>& use,
+                                const ReferenceFreeOptions& options) {
+  FreeProblem probe = fp;
+  const auto sol = probe.solve(use, false, true, true);
+  const double dof = 3.0 * static_cast<double>(sol.residuals) - static_cast<double>(4 + 3 * fp.segments.size());
+  const double variance_factor = dof > 0 ? 2.0 * sol.cost / dof : 1.0;
+  if (!(sol.var_dt > 0)) return;
+  const double sigma = std::sqrt(sol.var_dt * std::max(1.0, variance_factor));
+  const double z = std::abs(probe.dt - fp.dt) / sigma;
+  if (!(z > options.max_fixed_offset_z)) return;
+  throw MeasurementError(fmt::format(
+      "camera–IMU calibration: the time offset held fixed at {:.1f} ms contradicts the photos, which put it at "
+      "{:.1f} ± {:.1f} ms ({:.0f} σ away): a rotation fitted with the fixed value would carry the difference as an "
+      "error its σ does not cover; let the offset be estimated, or give the right one",
+      1e3 * fp.dt, 1e3 * probe.dt, 1e3 * sigma, z));
+}
+
+/// χ² test of the fit (ReferenceFreeOptions::max_variance_factor): a model that leaves residuals
+/// several times the photos' expected noise is refused, whatever σ its scaled covariance gives.
+void refuse_misfit(const ReferenceFreeCalibration& out, const ReferenceFreeOptions& options, double dt) {
+  if (!(out.variance_factor > options.max_variance_factor)) return;
+  const std::string cause =
+      out.time_offset_estimated
+          ? "a board moved within a placement, a gap or a jump in the gyroscope's log, or photos whose time stamps "
+            "are not the shutter's"
+          : fmt::format(
+                "the time offset held fixed at {:.1f} ms is likely wrong: let it be estimated, or give the "
+                "right one",
+                1e3 * dt);
+  throw MeasurementError(fmt::format(
+      "camera–IMU calibration: the photos' residuals are {:.1f} times their expected noise (χ²/dof {:.1f}, at most "
+      "{:.0f} accepted), so the rotation and time offset do not describe them: {}",
+      std::sqrt(out.variance_factor), out.variance_factor, options.max_variance_factor, cause));
+}
+
 /// The warning that every result of an uncalibrated gyroscope carries, with its figures.
 void warn_uncalibrated_gyroscope(ReferenceFreeCalibration& out, Diagnostics& diagnostics) {
   const Vec3 scale = 100.0 * (out.gyro_correction.diagonal() - Vec3::Ones());
@@ -380,7 +419,8 @@ OptionProblems ReferenceFreeOptions::Check() const {
                  (gyro_scale_sigma > 0.0 && gyro_cross_axis_sigma > 0.0)),
             "gyro_scale_sigma, gyro_cross_axis_sigma", "both 0 or both positive");
   p.require(finite({min_rate_deg_s, min_view_change_deg, min_axis_spread_deg, gyro_noise_density, max_gyro_gap_s,
-                    default_pnp_sigma_deg, sigma_floor_deg, huber_k, outlier_chi2, min_outlier_deg}) &&
+                    default_pnp_sigma_deg, sigma_floor_deg, huber_k, outlier_chi2, min_outlier_deg, max_variance_factor,
+                    max_fixed_offset_z}) &&
                 camera_rotation_sigma_rad.allFinite(),
             "thresholds and noise levels", "finite");
   p.require(min_photos_per_placement >= 2 && max_iterations >= 1, "min_photos_per_placement, max_iterations",
@@ -546,16 +586,18 @@ ReferenceFreeCalibration calibrate_reference_free(const std::vector<PhotoObserva
   // Pass 2: least squares on the inliers, covariance from Ceres scaled by the residual variance.
   // Parameters: x, and per segment a board attitude and a bias (the bias has its prior's 3 rows).
   const std::size_t params = 3 + 3 * P;
-  // The gyroscope correction's 9 prior rows balance its 9 parameters, as the bias's do. When it
-  // is estimated, a variance factor below 1 does not scale the covariance down: the correction
-  // fits part of the photos' noise (how many of its 9 parameters the photos determine, the count
-  // of degrees of freedom does not know), and the share of the covariance that its prior sets is
-  // a stated budget, not a fitted noise level.
+  // The gyroscope correction's 9 prior rows balance its 9 parameters, as the bias's do. The
+  // covariance is scaled by the variance factor only from above (the Birge ratio): residuals
+  // smaller than the photos' stated noise do not show that the rotation is better known, since
+  // what is common to all photos (the intrinsics, the IMU calibration's axes, the rendering or
+  // the lens) leaves no residual; and an estimated gyroscope correction fits part of the noise
+  // besides (how many of its 9 parameters the photos determine, the count of degrees of freedom
+  // does not know).
   auto final_solve = [&](bool with_dt) {
     const auto sol = fp.solve(use, false, with_dt, true);
     const double dof = 3.0 * static_cast<double>(sol.residuals) - static_cast<double>(params + (with_dt ? 1 : 0));
     out.variance_factor = dof > 0 ? 2.0 * sol.cost / dof : 1.0;
-    const double scale = fp.estimate_gyro() ? std::max(1.0, out.variance_factor) : out.variance_factor;
+    const double scale = std::max(1.0, out.variance_factor);
     if (sol.cov_x) out.covariance = *sol.cov_x * scale;
     const Vec3 bias_var(std::pow(options.camera_rotation_sigma_rad.x(), 2),
                         std::pow(options.camera_rotation_sigma_rad.y(), 2), 0.0);
@@ -592,6 +634,9 @@ ReferenceFreeCalibration calibrate_reference_free(const std::vector<PhotoObserva
     fp.dt = options.time_offset_start_s;
     final_solve(false);
   }
+  if (!options.estimate_time_offset && rad2deg(max_rate) >= options.min_rate_deg_s)
+    refuse_contradicted_offset(fp, use, options);
+  refuse_misfit(out, options, fp.dt);
   if (out.time_offset_estimated && (fp.dt < options.time_offset_min_s || fp.dt > options.time_offset_max_s))
     warn(diagnostics, warnings,
          fmt::format("time offset {:.4f} s lies outside the searched bracket [{}, {}] s", fp.dt,
