@@ -14,6 +14,7 @@
 #include "cli_provenance.hpp"
 #include "commands.hpp"
 #include "json_output.hpp"
+#include "progress.hpp"
 #include "device_calibration.hpp"
 
 namespace antpose::cli {
@@ -84,12 +85,15 @@ void run_camera(const CameraArgs& args, const CLI::App& verb) {
   if (!args.config.empty()) run_settings["config"] = args.config;
   std::vector<fs::path> inputs{args.capture};
   if (!args.config.empty()) inputs.emplace_back(args.config);
+  ProgressLine progress;
+  const auto report = progress.callback();
   run_calibration(device, "camera", run_settings, inputs, diagnostics, [&] {
+    // Each photo's outcome is in the table below; while it runs, only the count.
     const auto result =
         camera::calibrate_camera(fs::path(args.capture), settings, diagnostics,
-                                 [](const camera::CalibrationImage& im, std::size_t done, std::size_t total) {
-                                   fmt::print(stderr, "[{}/{}] {}: {}\n", done, total, im.image,
-                                              im.points > 0 ? fmt::format("{} points", im.points) : im.reason);
+                                 [&](const camera::CalibrationImage&, std::size_t done, std::size_t total) {
+                                   if (report)
+                                     report("board detection", static_cast<int>(done), static_cast<int>(total));
                                  });
     fmt::print("camera calibration of {} ({} {}x{})\n{}", args.capture, camera::to_string(result.board.type),
                result.board.cols, result.board.rows, camera::describe(result));

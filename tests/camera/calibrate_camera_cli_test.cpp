@@ -27,9 +27,15 @@ TEST(CalibrateCameraCli, WritesCameraYamlJsonAndPrintsTheTable) {
   EXPECT_THAT(r.out, HasSubstr("13 of 13 photos used"));
   EXPECT_THAT(r.out, HasSubstr("fx = 536.0734 ± 1.3580 px"));
   EXPECT_THAT(r.out, HasSubstr("RMS reprojection error 0.4087 px"));
-  EXPECT_THAT(r.err, HasSubstr("[13/13] images/left14.jpg: 54 points"));  // progress
+  EXPECT_THAT(r.err, ::testing::Not(HasSubstr("13/13")));  // no progress where stderr is no terminal
   const CameraFile c = read_camera_file(out);
   EXPECT_NEAR(c.intrinsics.fx, 536.0734168, 1e-4);
+  // Progress for a wrapper: one JSON object per photo.
+  const auto progress = test::run_cli(
+      fmt::format("calibrate camera {} -o {} --force --progress json", chess.string(), (dir / "again.yaml").string()));
+  ASSERT_EQ(progress.status, 0) << progress.err;
+  EXPECT_THAT(progress.err, HasSubstr(R"("done":13,)"));
+  EXPECT_THAT(progress.err, HasSubstr(R"("stage":"board detection","total":13})"));
   const auto j = nlohmann::json::parse(io::read_text(json));
   EXPECT_NEAR(j["cy_px"].get<double>(), 235.5368585, 1e-4);
   EXPECT_EQ(j["images"].size(), 13u);
