@@ -12,7 +12,7 @@ cd "$(dirname "$0")/.."
 SECONDS_PER_TARGET=${1:-600}
 shift || true
 BUILD=build-fuzz
-ALL=(fuzz_csv fuzz_capture_yaml fuzz_board_yaml fuzz_device_yaml fuzz_mesh fuzz_box_file fuzz_cof fuzz_thesis_xml)
+ALL=(fuzz_csv fuzz_capture_yaml fuzz_board_yaml fuzz_device_yaml fuzz_mesh fuzz_box_file fuzz_cof fuzz_thesis_xml fuzz_photo)
 [ $# -gt 0 ] && TARGETS=("$@") || TARGETS=("${ALL[@]}")
 
 cmake -S . -B "$BUILD" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ \
