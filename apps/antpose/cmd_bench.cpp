@@ -285,7 +285,8 @@ void add_bench_command(CLI::App& app) {
   auto oargs = std::make_shared<OrientationBenchArgs>();
   auto* ob = bench->add_subcommand("orientation", "score every orientation estimator against captures with truth");
   ob->add_option("dirs", oargs->dirs, "capture folders, or folders of capture folders")->required();
-  add_orientation_method_option(*ob, oargs->methods, "estimators to score (default: all)", {true, {}, {}});
+  add_orientation_method_option(*ob, oargs->methods, "estimators to score (default: all)",
+                                {.several = true, .other_names = {}, .other_hint = {}});
   add_renamed_option(*ob, "--methods", "--method");
   add_json_option(ob, oargs->json, "write the per-trial and mean results");
   ob->add_option("--wmm", oargs->wmm, "extra WMM coefficient files for the declination (repeatable; with the built-in "

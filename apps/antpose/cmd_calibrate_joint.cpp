@@ -279,7 +279,9 @@ void add_calibrate_joint_command(CLI::App& calibrate) {
   add_orientation_method_option(*cmd, args->orientation_methods,
                                 "orientation methods; the first serves the reference-free solver, the thesis "
                                 "tables list each",
-                                {true, {"reference-free", "thesis", "both"}, "the calibration solver is --solver"})
+                                {.several = true,
+                                 .other_names = {"reference-free", "thesis", "both"},
+                                 .other_hint = "the calibration solver is --solver"})
       ->capture_default_str();
   add_renamed_option(*cmd, "--orientation", "--method");
   cmd->add_option("--param", args->params, "orientation parameter name=value (repeatable)");

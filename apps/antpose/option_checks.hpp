@@ -22,8 +22,8 @@ void add_renamed_option(CLI::App& cmd, const std::string& old_name, const std::s
 /// How a verb takes its orientation method.
 struct OrientationMethodSettings {
   bool several = false;                  ///< a comma-separated list instead of one name
-  std::vector<std::string> other_names;  ///< values with another meaning in this verb's past, e.g. solver names
-  std::string other_hint;                ///< what to say when one of those is given
+  std::vector<std::string> other_names;  ///< values that name something else of the verb (its solvers)
+  std::string other_hint;                ///< what to answer when one of those is given
 };
 
 /// The option that names the orientation method, `--method` on every verb that has one; each
