@@ -4,6 +4,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <exiv2/exiv2.hpp>
+#include <fmt/format.h>
 #include <opencv2/imgcodecs.hpp>
 
 #include "antpose/io/text_file.hpp"
@@ -64,6 +66,26 @@ TEST(PhotoFile, AHeaderGivesTheSizeItClaimsWithoutDecoding) {
   EXPECT_THAT(read_photo_header(dir / "text.jpg").problem, HasSubstr("its header cannot be read ("));
   fs::create_directories(dir / "folder.jpg");
   EXPECT_EQ(read_photo_header(dir / "folder.jpg").problem, "is a folder, expected a file");
+}
+
+TEST(PhotoFile, PhotosAreReadAsStoredWhateverTheirExifOrientation) {
+  test::TempDir dir;
+  for (const int orientation : {1, 3, 6, 8}) {
+    const auto file = dir / fmt::format("o{}.jpg", orientation);
+    cv::imwrite(file.string(), cv::Mat(48, 64, CV_8UC1, cv::Scalar(90)));
+    auto image = Exiv2::ImageFactory::open(file.string());
+    image->readMetadata();
+    image->exifData()["Exif.Image.Orientation"] = static_cast<std::uint16_t>(orientation);
+    image->writeMetadata();
+    const PhotoHeader header = read_photo_header(file);
+    EXPECT_EQ(header.exif_orientation, orientation);
+    EXPECT_EQ(header.width_px, 64);
+    for (const int flags : {cv::IMREAD_GRAYSCALE, cv::IMREAD_COLOR, cv::IMREAD_UNCHANGED}) {
+      const Photo photo = read_photo(file, flags);
+      EXPECT_EQ(photo.image.cols, 64) << orientation << " " << flags;
+      EXPECT_EQ(photo.image.rows, 48) << orientation << " " << flags;
+    }
+  }
 }
 
 }  // namespace

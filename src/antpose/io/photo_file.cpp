@@ -17,7 +17,7 @@ Photo read_photo(const std::filesystem::path& file, int flags) {
   Photo photo;
   try {
     require_regular_file(file, kMaxPhotoBytes);
-    photo.image = cv::imread(file.string(), flags);
+    photo.image = cv::imread(file.string(), flags | cv::IMREAD_IGNORE_ORIENTATION);
     if (photo.image.empty()) photo.problem = "cannot be decoded: not a JPEG, PNG or TIFF photo, or truncated";
   } catch (const InputError& e) {
     photo.problem = e.detail();
@@ -54,6 +54,11 @@ PhotoHeader read_photo_header(const std::filesystem::path& file) {
     image->readMetadata();
     header.width_px = image->pixelWidth();
     header.height_px = image->pixelHeight();
+    const auto& exif = image->exifData();
+    if (const auto tag = exif.findKey(Exiv2::ExifKey("Exif.Image.Orientation")); tag != exif.end()) {
+      const long value = tag->toLong();
+      if (value >= 1 && value <= 8) header.exif_orientation = static_cast<int>(value);
+    }
     if (header.width_px <= 0 || header.height_px <= 0) header.problem = "its header gives no size";
   } catch (const InputError& e) {
     header.problem = e.detail();

@@ -22,7 +22,10 @@ struct Photo {
   bool ok() const { return problem.empty(); }
 };
 
-/// Decodes `file` with OpenCV's imread `flags`. A file that is missing, not a regular file, over
+/// Decodes `file` with OpenCV's imread `flags`, always as stored: an EXIF Orientation tag is not
+/// applied (OpenCV would apply it for some flags and not for others), because the intrinsics, the
+/// board's detection and the reconstruction all work in the sensor's pixels; the tag matters only
+/// for showing a photo upright and for coordinates read off an upright one (PhotoHeader). A file that is missing, not a regular file, over
 /// kMaxPhotoBytes, or that OpenCV refuses (not an image, truncated, a header claiming more
 /// pixels than OpenCV accepts) gives its reason in Photo::problem; it never throws for the file.
 Photo read_photo(const std::filesystem::path& file, int flags);
@@ -30,6 +33,7 @@ Photo read_photo(const std::filesystem::path& file, int flags);
 /// What a photo's header says, read without decoding its pixels (Exiv2).
 struct PhotoHeader {
   int width_px = 0, height_px = 0;  // as stored, before any EXIF orientation
+  int exif_orientation = 1;         // EXIF Orientation 1–8 (1: upright as stored, or no tag)
   std::string problem;              // as Photo::problem; also a header Exiv2 cannot read
   bool ok() const { return problem.empty(); }
 };
