@@ -64,6 +64,8 @@ TEST(PhotoFile, AHeaderGivesTheSizeItClaimsWithoutDecoding) {
 
   test::write_file(dir / "text.jpg", "not a photo");
   EXPECT_THAT(read_photo_header(dir / "text.jpg").problem, HasSubstr("its header cannot be read ("));
+  test::write_file(dir / "empty.jpg", "");
+  EXPECT_THAT(read_photo_header(dir / "empty.jpg").problem, HasSubstr("its header cannot be read ("));
   fs::create_directories(dir / "folder.jpg");
   EXPECT_EQ(read_photo_header(dir / "folder.jpg").problem, "is a folder, expected a file");
 }
