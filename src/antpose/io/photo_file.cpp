@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <exception>
+#include <fstream>
 #include <mutex>
 #include <new>
+#include <string_view>
 
 #include <exiv2/exiv2.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -12,13 +14,36 @@
 #include "antpose/io/file_access.hpp"
 
 namespace antpose::io {
+namespace {
+
+using namespace std::string_view_literals;
+
+constexpr const char* kNotAPhoto = "not a JPEG, PNG or TIFF photo";
+
+// Whether the file starts as a JPEG, PNG or TIFF does. OpenCV's imread would otherwise take any
+// decoder whose signature it finds anywhere it looks (Debian's build has GDAL and GDCM: "DICM"
+// at byte 128 makes a DICOM file, whose reader allocates what its lengths claim).
+bool has_photo_signature(const std::filesystem::path& file) {
+  char head[8] = {};
+  std::ifstream in(file, std::ios::binary);
+  in.read(head, sizeof head);
+  const std::string_view h(head, static_cast<std::size_t>(in.gcount()));
+  return h.starts_with("\xFF\xD8\xFF"sv) || h.starts_with("\x89PNG\r\n\x1A\n"sv) || h.starts_with("II*\0"sv) ||
+         h.starts_with("MM\0*"sv);
+}
+
+}  // namespace
 
 Photo read_photo(const std::filesystem::path& file, int flags) {
   Photo photo;
   try {
     require_regular_file(file, kMaxPhotoBytes);
+    if (!has_photo_signature(file)) {
+      photo.problem = std::string("cannot be decoded: ") + kNotAPhoto;
+      return photo;
+    }
     photo.image = cv::imread(file.string(), flags | cv::IMREAD_IGNORE_ORIENTATION);
-    if (photo.image.empty()) photo.problem = "cannot be decoded: not a JPEG, PNG or TIFF photo, or truncated";
+    if (photo.image.empty()) photo.problem = std::string("cannot be decoded: ") + kNotAPhoto + ", or truncated";
   } catch (const InputError& e) {
     photo.problem = e.detail();
   } catch (const cv::Exception& e) {
@@ -50,6 +75,10 @@ PhotoHeader read_photo_header(const std::filesystem::path& file) {
   PhotoHeader header;
   try {
     require_regular_file(file, kMaxPhotoBytes);
+    if (!has_photo_signature(file)) {
+      header.problem = kNotAPhoto;
+      return header;
+    }
     auto image = Exiv2::ImageFactory::open(file.string());
     image->readMetadata();
     header.width_px = image->pixelWidth();
