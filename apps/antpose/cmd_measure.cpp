@@ -212,7 +212,9 @@ void add_measure_command(CLI::App& app) {
   cmd->add_option("--model-box", a->model_boxes, "the mesh's A–H box file (fixes the antenna frame), one per --model");
   cmd->add_option("--model-units", a->model_units, "units of the mesh and box: m or mm")->capture_default_str();
   cmd->add_flag("--model-canonical", a->model_canonical, "the mesh is already in the antenna frame (no box file)");
-  cmd->add_option("--roi", a->rois, "IMAGE:x,y,w,h: the antenna's rectangle in one photo (px); once per antenna")
+  cmd->add_option(
+         "--roi", a->rois,
+         "IMAGE:x,y,w,h: the antenna's rectangle in one photo (px, on the photo shown upright); once per antenna")
       ->required();
   add_orientation_method_option(*cmd, a->orientation, "phone orientation method")->capture_default_str();
   add_renamed_option(*cmd, "--orientation", "--method");

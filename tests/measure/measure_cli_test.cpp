@@ -2,12 +2,15 @@
 // number it cannot support. One small simulated antenna capture serves all cases; the device
 // profile is the simulator's truth (these tests check messages, not accuracy: that is the long
 // acceptance test's job).
+#include <array>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
 
 #include <fmt/format.h>
+#include <exiv2/exiv2.hpp>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -263,6 +266,52 @@ TEST_F(MeasureCli, AWrongBoardSizeIsNamedWhereTheAntennaFails) {
   EXPECT_THAT(r.err, HasSubstr("faster than a person framing photos walks (limit 3.0 m/s): check square_m (" +
                                tenfold_m + " in board.yaml)"));
   EXPECT_THAT(r.out, HasSubstr("the board's scale is in doubt (see the warning on square_m)"));
+}
+
+// Phone photos stored in the sensor's pixels with an EXIF turn: the rectangle is drawn on the photo
+// shown upright, and the measurement equals the untagged one's.
+TEST_F(MeasureCli, PhotosWithAnExifTurnMeasureAsUntagged) {
+  const auto angles = [](const nlohmann::json& j) {
+    const auto& a = j["antennas"][0];
+    return std::array{a["azimuth_magnetic_deg"].get<double>(), a["downtilt_deg"].get<double>(),
+                      a["roll_deg"].get<double>()};
+  };
+  const auto plain_json = *dir_ / "untagged.json";
+  auto r = test::run_cli(
+      measure(capture(), fmt::format("--model {} --roi {} --json '{}'", model_, roi_, plain_json.string())));
+  ASSERT_THAT(r.status, AnyOf(0, 4)) << r.err;
+  const auto plain = angles(nlohmann::json::parse(io::read_text(plain_json)));
+  int x = 0, y = 0, w = 0, h = 0;
+  ASSERT_EQ(std::sscanf(roi_.substr(roi_.rfind(':') + 1).c_str(), "%d,%d,%d,%d", &x, &y, &w, &h), 4);
+  const int W = 960, H = 720;
+  for (const int orientation : {6, 8}) {
+    const auto cap = copy(fmt::format("exif-{}", orientation));
+    for (const auto& entry : fs::directory_iterator(cap / "images")) {
+      auto image = Exiv2::ImageFactory::open(entry.path().string());
+      image->readMetadata();
+      image->exifData()["Exif.Image.Orientation"] = static_cast<std::uint16_t>(orientation);
+      image->writeMetadata();
+    }
+    // The rectangle on the photo turned upright (io/exif_orientation.hpp): 6 turns it clockwise.
+    const auto upright = orientation == 6 ? fmt::format("{},{},{},{}", H - y - h, x, h, w)
+                                          : fmt::format("{},{},{},{}", y, W - x - w, h, w);
+    const auto json = *dir_ / fmt::format("exif-{}.json", orientation);
+    const auto report = *dir_ / fmt::format("exif-{}-report", orientation);
+    r = test::run_cli(measure(cap, fmt::format("--model {} --roi {}:{} --json '{}' --report '{}'", model_, roi_image_,
+                                               upright, json.string(), report.string())));
+    ASSERT_THAT(r.status, AnyOf(0, 4)) << r.err;
+    const auto j = nlohmann::json::parse(io::read_text(json));
+    EXPECT_EQ(j["antennas"][0]["roi"]["exif_orientation"], orientation);
+    const auto tagged = angles(j);
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(tagged[k], plain[k], 1e-6) << orientation;
+    // The report shows the photos upright.
+    const cv::Mat overlay = cv::imread((report / "overlay_01.jpg").string());
+    EXPECT_GT(overlay.rows, overlay.cols) << orientation;
+  }
+  // A rectangle that fits the stored photo but not the upright one is named as such.
+  r = test::run_cli(measure(*dir_ / "exif-6", fmt::format("--model {} --roi {}:700,10,200,40", model_, roi_image_)));
+  EXPECT_EQ(r.status, 2);
+  EXPECT_THAT(r.err, HasSubstr("reaches outside the 720×960 image (as shown upright)"));
 }
 
 TEST_F(MeasureCli, PhotosAllFromOnePlaceGiveNoConfidentNumber) {

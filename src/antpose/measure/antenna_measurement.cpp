@@ -301,7 +301,7 @@ AntennaRoi parse_roi(const std::string& text) {
     throw InputError("--roi", fmt::format("'{}': x and y must be ≥ 0 and the width and height at least 8 px", text));
   AntennaRoi r;
   r.image = text.substr(0, colon);
-  r.roi = {x, y, w, h};
+  r.roi = r.drawn = {x, y, w, h};
   return r;
 }
 

@@ -29,9 +29,14 @@
 namespace antpose::measure {
 
 /// A user's rectangle: `image` as in shots.csv (or its file name), the rectangle in its pixels.
+/// `drawn` is as the user gave it, on the photo shown upright; `roi` is the same rectangle in the
+/// photo's stored pixels, where the measurement works (in_stored_pixels; equal where the photo has
+/// no EXIF turn, exif_orientation 1).
 struct AntennaRoi {
   std::string image;
   reconstruction::Roi roi;
+  reconstruction::Roi drawn;
+  int exif_orientation = 1;
 };
 
 /// Parses "IMAGE:x,y,w,h" (InputError naming the value and the expected form).

@@ -5,6 +5,9 @@
 
 #include <fmt/format.h>
 
+#include "antpose/io/exif_orientation.hpp"
+#include "antpose/io/photo_file.hpp"
+
 namespace antpose::measure {
 namespace {
 namespace fs = std::filesystem;
@@ -31,11 +34,24 @@ std::size_t roi_shot(const Capture& capture, const AntennaRoi& roi) {
 
 void check_rois_inside(const NonContactSetup& setup, const camera::CameraIntrinsics& photos) {
   for (const auto& roi : setup.rois) {
-    const auto& r = roi.roi;
-    if (r.x + r.width > photos.width || r.y + r.height > photos.height)
-      throw InputError("--roi", fmt::format("{}:{},{},{},{} reaches outside the {}×{} image", roi.image, r.x, r.y,
-                                            r.width, r.height, photos.width, photos.height));
+    const auto& r = roi.drawn;
+    const cv::Size shown = io::upright_size({photos.width, photos.height}, roi.exif_orientation);
+    if (r.x + r.width > shown.width || r.y + r.height > shown.height)
+      throw InputError("--roi", fmt::format("{}:{},{},{},{} reaches outside the {}×{} image{}", roi.image, r.x, r.y,
+                                            r.width, r.height, shown.width, shown.height,
+                                            roi.exif_orientation == 1 ? "" : " (as shown upright)"));
   }
+}
+
+// The ROI drawn on the photo shown upright, in the photo's stored pixels (io/exif_orientation.hpp).
+AntennaRoi in_stored_pixels(AntennaRoi roi, const fs::path& photo) {
+  const io::PhotoHeader header = io::read_photo_header(photo);
+  if (!header.ok()) return roi;  // the photo's own reason comes with its board pose
+  roi.exif_orientation = header.exif_orientation;
+  const cv::Rect& d = {roi.drawn.x, roi.drawn.y, roi.drawn.width, roi.drawn.height};
+  const cv::Rect s = io::stored_rect(d, {header.width_px, header.height_px}, header.exif_orientation);
+  roi.roi = {s.x, s.y, s.width, s.height};
+  return roi;
 }
 
 // The reconstruction's rotation uncertainty from the camera poses (board frame, rad²): each
@@ -221,16 +237,19 @@ OptionProblems NonContactOptions::Check() const {
   return p;
 }
 
-NonContactResult measure_non_contact(const Capture& capture, const NonContactSetup& setup,
+NonContactResult measure_non_contact(const Capture& capture, const NonContactSetup& given,
                                      const NonContactOptions& options, Diagnostics& diagnostics) {
   throw_unless_ok(options.Check(), "NonContactOptions");
   require_android_frame(capture, "the non-contact measurement");
-  if (setup.models.size() > 1 && setup.models.size() != setup.rois.size())
+  if (given.models.size() > 1 && given.models.size() != given.rois.size())
     throw InputError("--model", fmt::format("{} models for {} regions: give one model for all, or one per --roi in "
                                             "the same order",
-                                            setup.models.size(), setup.rois.size()));
+                                            given.models.size(), given.rois.size()));
   std::vector<std::size_t> roi_shots;
-  for (const auto& roi : setup.rois) roi_shots.push_back(roi_shot(capture, roi));
+  for (const auto& roi : given.rois) roi_shots.push_back(roi_shot(capture, roi));
+  NonContactSetup setup = given;  // the ROIs in the photos' stored pixels
+  for (std::size_t k = 0; k < setup.rois.size(); ++k)
+    setup.rois[k] = in_stored_pixels(given.rois[k], capture.root / capture.shots[roi_shots[k]].image);
   NonContactResult result;
   for (const auto& s : capture.shots) result.photos.push_back(s.image);
   const auto progress = [&](const std::string& s, int d, int t) { report(options, s, d, t); };

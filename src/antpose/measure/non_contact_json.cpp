@@ -69,11 +69,10 @@ nlohmann::json time_offset_json(const TimeOffsetCheck& t) {
 
 nlohmann::json antenna_json(const AntennaMeasurement& m) {
   nlohmann::json a;
-  a["roi"] = {{"image", m.roi.image},
-              {"x_px", m.roi.roi.x},
-              {"y_px", m.roi.roi.y},
-              {"width_px", m.roi.roi.width},
-              {"height_px", m.roi.roi.height}};
+  // As drawn, on the photo shown upright (the measurement's own rectangle is in the stored pixels).
+  a["roi"] = {
+      {"image", m.roi.image},          {"x_px", m.roi.drawn.x},           {"y_px", m.roi.drawn.y},
+      {"width_px", m.roi.drawn.width}, {"height_px", m.roi.drawn.height}, {"exif_orientation", m.roi.exif_orientation}};
   a["error"] = m.error ? nlohmann::json(*m.error) : nlohmann::json(nullptr);
   const bool ok = !m.error;
   const auto& at = m.attitude;

@@ -10,6 +10,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "antpose/io/exif_orientation.hpp"
 #include "antpose/io/report_text.hpp"
 #include "antpose/io/text_file.hpp"
 #include "antpose/model/mesh.hpp"
@@ -273,6 +274,9 @@ void write_report(const fs::path& folder, const Capture& capture, const NonConta
           draw_overlay(image, scale, result.intrinsics, result.poses.R_camera_board[i], result.poses.t_camera_board[i],
                        m, setup.model_for(k), static_cast<int>(k + 1));
       }
+      // Drawn in the stored pixels, shown upright.
+      if (const auto header = io::read_photo_header(capture.root / shot.image); header.ok())
+        image = io::upright_image(image, header.exif_orientation);
       const auto name = fmt::format("overlay_{:02d}.jpg", i + 1);
       if (!cv::imwrite((tmp / name).string(), image, {cv::IMWRITE_JPEG_QUALITY, 88}))
         throw Error(fmt::format("could not write {}", (tmp / name).string()));

@@ -74,6 +74,7 @@ std::vector<TruthAntenna> read_truth_antennas(const std::filesystem::path& captu
                  static_cast<int>(io::yaml_integer(roi["y"], file, at + ".roi.y")),
                  static_cast<int>(io::yaml_integer(roi["width"], file, at + ".roi.width")),
                  static_cast<int>(io::yaml_integer(roi["height"], file, at + ".roi.height"))};
+    t.roi.drawn = t.roi.roi;  // the truth's rectangle is on the photo as shown
     t.model = io::yaml_string(a["model"], file, at + ".model");
     t.azimuth_magnetic = deg2rad(io::yaml_number(a["azimuth_magnetic_deg"], file, at + ".azimuth_magnetic_deg"));
     t.downtilt = deg2rad(io::yaml_number(a["downtilt_deg"], file, at + ".downtilt_deg"));
