@@ -48,7 +48,7 @@ AntennaRoi in_stored_pixels(AntennaRoi roi, const fs::path& photo) {
   const io::PhotoHeader header = io::read_photo_header(photo);
   if (!header.ok()) return roi;  // the photo's own reason comes with its board pose
   roi.exif_orientation = header.exif_orientation;
-  const cv::Rect& d = {roi.drawn.x, roi.drawn.y, roi.drawn.width, roi.drawn.height};
+  const cv::Rect d(roi.drawn.x, roi.drawn.y, roi.drawn.width, roi.drawn.height);
   const cv::Rect s = io::stored_rect(d, {header.width_px, header.height_px}, header.exif_orientation);
   roi.roi = {s.x, s.y, s.width, s.height};
   return roi;
