@@ -344,6 +344,13 @@ void refuse_offset_blurred_by_gyroscope(const ReferenceFreeCalibration& out, con
       1e3 * out.time_offset_sigma_fit_s, 1e3 * limit));
 }
 
+/// χ²/dof of a solution's whitened residuals (3 per photo) with `params` parameters fitted; 1
+/// where there are no degrees of freedom left.
+double variance_factor_of(const FreeProblem::Solution& sol, std::size_t params) {
+  const double dof = 3.0 * static_cast<double>(sol.residuals) - static_cast<double>(params);
+  return dof > 0 ? 2.0 * sol.cost / dof : 1.0;
+}
+
 /// The test of a time offset given as fixed (ReferenceFreeOptions::max_fixed_offset_z): the fit is
 /// repeated with δt free, from the fixed value, and where the photos put δt further from it than
 /// that many σ (σ scaled by the refit's variance factor where above 1), the fixed value is
@@ -352,8 +359,7 @@ void refuse_contradicted_offset(const FreeProblem& fp, const std::vector<bool>& 
                                 const ReferenceFreeOptions& options) {
   FreeProblem probe = fp;
   const auto sol = probe.solve(use, false, true, true);
-  const double dof = 3.0 * static_cast<double>(sol.residuals) - static_cast<double>(4 + 3 * fp.segments.size());
-  const double variance_factor = dof > 0 ? 2.0 * sol.cost / dof : 1.0;
+  const double variance_factor = variance_factor_of(sol, 4 + 3 * fp.segments.size());
   if (!(sol.var_dt > 0)) return;
   const double sigma = std::sqrt(sol.var_dt * std::max(1.0, variance_factor));
   const double z = std::abs(probe.dt - fp.dt) / sigma;
@@ -595,8 +601,7 @@ ReferenceFreeCalibration calibrate_reference_free(const std::vector<PhotoObserva
   // does not know).
   auto final_solve = [&](bool with_dt) {
     const auto sol = fp.solve(use, false, with_dt, true);
-    const double dof = 3.0 * static_cast<double>(sol.residuals) - static_cast<double>(params + (with_dt ? 1 : 0));
-    out.variance_factor = dof > 0 ? 2.0 * sol.cost / dof : 1.0;
+    out.variance_factor = variance_factor_of(sol, params + (with_dt ? 1 : 0));
     const double scale = std::max(1.0, out.variance_factor);
     if (sol.cov_x) out.covariance = *sol.cov_x * scale;
     const Vec3 bias_var(std::pow(options.camera_rotation_sigma_rad.x(), 2),

@@ -578,7 +578,8 @@ CameraCalibrationResult calibrate_camera(const Capture& capture, const Calibrati
   std::vector<CalibrationView> views;
   std::vector<CalibrationImage> images;
   // One camera mode per calibration: the size most photos' headers give (else the first decoded).
-  const std::optional<cv::Size> common_size = io::common_photo_size(capture);
+  const std::vector<io::PhotoHeader> headers = io::read_photo_headers(capture);
+  const std::optional<cv::Size> common_size = io::common_photo_size(headers);
   int width = 0, height = 0;
   auto detect_all = [&](const DetectionOptions& options, Diagnostics* warn, const CalibrationProgress* report) {
     views.clear();
@@ -594,7 +595,7 @@ CameraCalibrationResult calibrate_camera(const Capture& capture, const Calibrati
       im.image = shot.image;
       CalibrationView view;
       view.name = shot.image;
-      const io::PhotoHeader header = io::read_photo_header(file);
+      const io::PhotoHeader& header = headers[i];
       const bool other_size = common_size && header.ok() && cv::Size(header.width_px, header.height_px) != *common_size;
       io::Photo photo = other_size ? io::Photo{} : io::read_photo(file, cv::IMREAD_UNCHANGED);
       cv::Mat image = std::move(photo.image);

@@ -97,10 +97,15 @@ PhotoHeader read_photo_header(const std::filesystem::path& file) {
   return header;
 }
 
-std::optional<cv::Size> common_photo_size(const Capture& capture) {
+std::vector<PhotoHeader> read_photo_headers(const Capture& capture) {
+  std::vector<PhotoHeader> headers;
+  for (const auto& shot : capture.shots) headers.push_back(read_photo_header(capture.root / shot.image));
+  return headers;
+}
+
+std::optional<cv::Size> common_photo_size(const std::vector<PhotoHeader>& headers) {
   std::vector<std::pair<cv::Size, std::size_t>> counts;  // in order of first appearance
-  for (const auto& shot : capture.shots) {
-    const auto header = read_photo_header(capture.root / shot.image);
+  for (const auto& header : headers) {
     if (!header.ok()) continue;
     const cv::Size size(header.width_px, header.height_px);
     const auto at = std::find_if(counts.begin(), counts.end(), [&](const auto& c) { return c.first == size; });

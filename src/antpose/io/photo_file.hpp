@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
@@ -42,10 +43,13 @@ struct PhotoHeader {
 /// is what the file claims; a photo whose claim is false is refused when it is decoded.
 PhotoHeader read_photo_header(const std::filesystem::path& file);
 
-/// The size most of the capture's photos share, from their headers; nullopt where no header can
-/// be read. Ties go to the size of the earlier photo. One file whose header claims another size
-/// (a resized copy, a damaged header) is then refused alone, by the caller's size check, instead
-/// of deciding the size for all.
-std::optional<cv::Size> common_photo_size(const Capture& capture);
+/// The header of every photo of the capture, in shot order.
+std::vector<PhotoHeader> read_photo_headers(const Capture& capture);
+
+/// The size most of the photos share, from their headers; nullopt where no header can be read.
+/// Ties go to the size of the earlier photo. One file whose header claims another size (a resized
+/// copy, a damaged header) is then refused alone, by the caller's size check, instead of deciding
+/// the size for all.
+std::optional<cv::Size> common_photo_size(const std::vector<PhotoHeader>& headers);
 
 }  // namespace antpose::io

@@ -15,7 +15,7 @@ namespace {
 // size where that is the same sensor at another resolution.
 camera::CameraIntrinsics photo_intrinsics(const Capture& capture, const camera::CameraIntrinsics& calibrated,
                                           std::vector<std::string>& warnings) {
-  const auto size = io::common_photo_size(capture);
+  const auto size = io::common_photo_size(io::read_photo_headers(capture));
   if (!size) return calibrated;  // each photo then gets its own reason
   const int width = size->width, height = size->height;
   if (width == calibrated.width && height == calibrated.height) return calibrated;

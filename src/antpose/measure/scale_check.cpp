@@ -6,7 +6,9 @@
 #include <Eigen/Eigenvalues>
 #include <fmt/format.h>
 
+#include "antpose/camera/board_pose.hpp"
 #include "antpose/core/statistics.hpp"
+#include "antpose/geometry/point_cloud.hpp"
 
 namespace antpose::measure {
 
@@ -28,7 +30,8 @@ WalkScale check_walk_scale(const Capture& capture, const CameraPoses& poses, con
   std::vector<Stop> stops;
   for (std::size_t v = 0; v < poses.views.size(); ++v) {
     const auto& view = poses.views[v];
-    stops.push_back({capture.shots[poses.shot_of_view[v]].t, -view.R_camera_board.transpose() * view.t_camera_board});
+    stops.push_back(
+        {capture.shots[poses.shot_of_view[v]].t, camera::camera_centre(view.R_camera_board, view.t_camera_board)});
   }
   std::sort(stops.begin(), stops.end(), [](const Stop& a, const Stop& b) { return a.t < b.t; });
   std::vector<double> speeds;
@@ -51,9 +54,7 @@ std::optional<std::string> model_scale_hint(const std::vector<Vec3>& points_boar
                                             const camera::BoardSpec& board, const ScaleCheckOptions& options) {
   throw_unless_ok(options.Check(), "ScaleCheckOptions");
   if (points_board.size() < 10) return std::nullopt;
-  Vec3 mean = Vec3::Zero();
-  for (const Vec3& p : points_board) mean += p;
-  mean /= static_cast<double>(points_board.size());
+  const Vec3 mean = centroid(points_board);
   Mat3 scatter = Mat3::Zero();
   for (const Vec3& p : points_board) scatter += (p - mean) * (p - mean).transpose();
   const Eigen::SelfAdjointEigenSolver<Mat3> es(scatter);
